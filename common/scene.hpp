@@ -1,0 +1,99 @@
+// Strict scene reading (TOML through toml11). A SceneTable is a view on one table of the scene
+// file that records every key it is asked for: finish() then reports any key nobody asked for
+// as unknown, with a "did you mean" among the keys that were asked for. Every accessor checks
+// type and range and throws fsi::InputError naming the key path, the value and file:line.
+// Values read (with defaults filled in) are recorded into the effective scene.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "error.hpp"
+
+namespace fsi {
+
+struct SceneDoc;  // parsed file plus the effective-scene record (scene.cpp)
+
+class SceneTable {
+ public:
+  // Numbers (TOML integers are accepted where a float is asked for).
+  double number(std::string_view key) const;
+  double number(std::string_view key, double fallback) const;
+  double positive(std::string_view key) const;                  // > 0
+  double positive(std::string_view key, double fallback) const;
+  double non_negative(std::string_view key) const;              // >= 0
+  double non_negative(std::string_view key, double fallback) const;
+  // lo < value < hi when open, lo <= value <= hi otherwise.
+  double in_range(std::string_view key, double lo, double hi, bool open,
+                  std::optional<double> fallback = std::nullopt) const;
+  long integer(std::string_view key) const;
+  long integer(std::string_view key, long fallback) const;
+  long positive_integer(std::string_view key) const;           // >= 1
+  long positive_integer(std::string_view key, long fallback) const;
+  bool boolean(std::string_view key, bool fallback) const;
+  std::string string(std::string_view key) const;
+  std::string string(std::string_view key, std::string_view fallback) const;
+  // One of `choices`; the error lists them.
+  std::string choice(std::string_view key, const std::vector<std::string>& choices,
+                     std::optional<std::string> fallback = std::nullopt) const;
+  std::array<double, 2> vec2(std::string_view key) const;
+  std::array<double, 2> vec2(std::string_view key, std::array<double, 2> fallback) const;
+  std::vector<double> numbers(std::string_view key) const;
+  std::vector<double> numbers(std::string_view key, std::vector<double> fallback) const;
+  // A file path relative to the scene file's folder; it must exist.
+  std::filesystem::path existing_file(std::string_view key) const;
+
+  bool has(std::string_view key) const;
+  SceneTable table(std::string_view key) const;                  // required sub-table
+  std::optional<SceneTable> optional_table(std::string_view key) const;
+  // An array of tables ([[key]]); empty when absent.
+  std::vector<SceneTable> tables(std::string_view key) const;
+
+  // Error about this table's `key` (its current value and location are added).
+  [[noreturn]] void fail(std::string_view key, const std::string& message) const;
+  // Error about the table itself.
+  [[noreturn]] void fail_table(const std::string& message) const;
+  // Unknown-key check: call once every key of this table has been read.
+  void finish() const;
+  // Mark `key` as known without reading it (a section another program reads).
+  void skip(std::string_view key) const;
+
+  const std::string& path() const { return m_path; }  // "fluid.bc", "" for the root
+  const std::filesystem::path& file() const;
+
+ private:
+  friend class Scene;
+  SceneTable(std::shared_ptr<SceneDoc> doc, const void* value, std::string path);
+  const void* lookup(std::string_view key) const;  // toml value or nullptr; marks key as asked
+  std::string key_path(std::string_view key) const;
+  void record(std::string_view key, const std::string& toml_text) const;
+
+  std::shared_ptr<SceneDoc> m_doc;
+  const void* m_value;  // const toml::value*
+  std::string m_path;
+};
+
+// A whole scene file. Construction parses it (missing file, syntax errors: InputError).
+class Scene {
+ public:
+  explicit Scene(const std::filesystem::path& file);
+  SceneTable root() const;
+  const std::filesystem::path& file() const;
+  const std::string& contents() const;   // raw bytes, for the identity check
+  std::uint64_t hash() const;            // FNV-1a of the contents
+  // The effective scene: every key read so far, with defaults filled in, as TOML text.
+  std::string effective_toml() const;
+
+ private:
+  std::shared_ptr<SceneDoc> m_doc;
+};
+
+// Levenshtein distance, for "did you mean".
+std::size_t edit_distance(std::string_view a, std::string_view b);
+
+}  // namespace fsi
