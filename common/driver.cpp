@@ -1,0 +1,155 @@
+// serve(): the solver side of the step sequence (see driver.hpp and common/PROTOCOL.md).
+#include "driver.hpp"
+
+#include <cmath>
+#include <fstream>
+
+namespace fsi {
+
+bool is_output_step(const CommonSettings& s, long n) {
+  if (s.output_interval <= 0) return false;
+  if (n == 0 || n == s.steps) return true;
+  const double k_now = std::floor(step_time(s, n) / s.output_interval + 1e-9);
+  const double k_before = std::floor(step_time(s, n - 1) / s.output_interval + 1e-9);
+  return k_now > k_before;
+}
+
+void write_summary(const Runtime& rt, const nlohmann::json& summary) {
+  const auto path = rt.out_dir() / "summary.json";
+  const auto tmp = rt.out_dir() / "summary.json.tmp";
+  {
+    std::ofstream out(tmp);
+    out << summary.dump(2) << "\n";
+    if (!out) fail("cannot write {}", tmp.string());
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+namespace {
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  if (!out) fail("cannot write {}", path.string());
+}
+
+nlohmann::json base_summary(const Runtime& rt, long steps) {
+  nlohmann::json j;
+  j["scene"] = rt.settings().name;
+  j["scene_file"] = rt.scene().file().string();
+  j["steps"] = steps;
+  j["time"] = step_time(rt.settings(), steps);
+  j["dt"] = rt.settings().dt;
+  return j;
+}
+
+// Standalone: this solver is the clock; coupling inputs stay empty.
+template <class Port, class Advance>
+void run_alone(Runtime& rt, Port& port, Advance advance) {
+  const auto& s = rt.settings();
+  write_text(rt.out_dir() / "scene.effective.toml", rt.scene().effective_toml());
+  port.output(0, 0.0, is_output_step(s, 0));
+  const double t0 = rt.wall_seconds();
+  double last_print = t0;
+  for (long n = 0; n < s.steps; ++n) {
+    rt.check_fault(n);
+    const proto::StepBegin sb{n, step_time(s, n), s.dt, proto::Action::step};
+    advance(sb);
+    port.output(n + 1, step_time(s, n + 1), is_output_step(s, n + 1));
+    const double now = rt.wall_seconds();
+    if (now - last_print > 2.0 || n + 1 == s.steps) {
+      const double rate = (n + 1) / std::max(now - t0, 1e-9);
+      std::fprintf(stderr, "[%s] step %ld/%ld  t=%.6g  dt=%.3g  %s  %.1f steps/s  ETA %.0f s\n",
+                   rt.name(), n + 1, s.steps, step_time(s, n + 1), s.dt, port.status().c_str(), rate,
+                   (s.steps - n - 1) / rate);
+      last_print = now;
+    }
+  }
+  nlohmann::json j = base_summary(rt, s.steps);
+  j["wall_time"][rt.name()] = rt.wall_seconds();
+  j[rt.name()] = port.report();
+  write_summary(rt, j);
+  std::fprintf(stderr, "[%s] done: %ld steps in %.2f s; output in %s\n", rt.name(), s.steps,
+               rt.wall_seconds(), rt.out_dir().string().c_str());
+}
+
+// Coupled: follow the coupler's step_begin messages until it says stop.
+template <class Port, class Advance>
+void follow(Runtime& rt, Port& port, Advance advance) {
+  Link& c = rt.coupler_link();
+  c.send(proto::Text{proto::Tag::effective_scene, rt.scene().effective_toml()});
+  const auto& s = rt.settings();
+  port.output(0, 0.0, is_output_step(s, 0));
+  long steps = 0;
+  for (;;) {
+    proto::StepBegin sb;
+    c.recv(sb);
+    if (sb.action == proto::Action::stop) break;
+    rt.check_fault(sb.step);
+    advance(sb);
+    steps = sb.step + 1;
+    port.output(steps, sb.time + sb.dt, is_output_step(s, steps));
+  }
+  nlohmann::json j = port.report();
+  j["wall_time"] = rt.wall_seconds();
+  j["steps"] = steps;
+  j["bytes_sent"] = c.bytes_sent();
+  j["bytes_received"] = c.bytes_received();
+  c.send(proto::Text{proto::Tag::final_report, j.dump()});
+}
+
+}  // namespace
+
+void serve(Runtime& rt, FluidPort& port) {
+  proto::FluidInput in;
+  proto::FluidOutput out;
+  if (!rt.coupled()) return run_alone(rt, port, [&](const proto::StepBegin& sb) {
+    port.advance(sb, in, out);
+  });
+  rt.coupler_link().send(port.grid_info());
+  follow(rt, port, [&](const proto::StepBegin& sb) {
+    rt.coupler_link().recv(in);
+    port.advance(sb, in, out);
+    rt.coupler_link().send(out, sb.step);
+  });
+}
+
+void serve(Runtime& rt, SolidPort& port) {
+  proto::SolidInput in;
+  proto::SolidState st;
+  if (!rt.coupled()) return run_alone(rt, port, [&](const proto::StepBegin& sb) {
+    port.advance(sb, in);
+  });
+  Link& c = rt.coupler_link();
+  c.send(port.meshes());
+  port.state(st);
+  c.send(st);
+  follow(rt, port, [&](const proto::StepBegin& sb) {
+    c.recv(in);
+    port.advance(sb, in);
+    port.state(st);
+    c.send(st, sb.step);
+  });
+}
+
+void serve(Runtime& rt, FiberPort& port) {
+  proto::FiberInput in;
+  proto::FiberState st;
+  if (!rt.coupled()) return run_alone(rt, port, [&](const proto::StepBegin& sb) {
+    port.advance(sb, in);
+  });
+  Link& c = rt.coupler_link();
+  c.send(port.layout());
+  c.recv(in);  // root poses at t^0
+  port.set_initial_roots(in.root_pose);
+  port.state(st);
+  c.send(st);
+  follow(rt, port, [&](const proto::StepBegin& sb) {
+    c.recv(in);
+    port.advance(sb, in);
+    port.state(st);
+    c.send(st, sb.step);
+  });
+}
+
+}  // namespace fsi

@@ -1,0 +1,70 @@
+// The solver side of a run, written once for every solver: a solver implements the port of its
+// role and serve() drives it, either following the coupler's clock through the per-step message
+// sequence of common/PROTOCOL.md, or alone (a scene with that one physics) on its own clock with
+// empty coupling inputs. Replacing a solver means implementing one of these ports.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "protocol.hpp"
+#include "runtime.hpp"
+
+namespace fsi {
+
+// What every solver offers the driver besides its physics. Not called inside a step's loops.
+class SolverPort {
+ public:
+  virtual ~SolverPort() = default;
+  // After step `step` reached time t (also called once with step 0 at t = 0): write probes
+  // (cheap, every step) and fields when `fields` is true (the scene's output interval).
+  virtual void output(long step, double t, bool fields) = 0;
+  // Extra fields for the progress line of a standalone run ("CFL 0.31  div 1e-15").
+  virtual std::string status() const { return {}; }
+  // This solver's part of summary.json (phases, iterations, metrics).
+  virtual nlohmann::json report() const { return nlohmann::json::object(); }
+};
+
+class FluidPort : public SolverPort {
+ public:
+  virtual proto::GridInfo grid_info() const = 0;
+  // One fluid step t^n -> t^n + dt with the coupler's sparse input; fills `out` (f_s on the
+  // solid faces, samples of u^(n+1), diagnostics).
+  virtual void advance(const proto::StepBegin& s, const proto::FluidInput& in,
+                       proto::FluidOutput& out) = 0;
+};
+
+class SolidPort : public SolverPort {
+ public:
+  virtual proto::BodyMeshes meshes() const = 0;
+  virtual void state(proto::SolidState& s) const = 0;  // current x, v of every body
+  // One solid step with nodal forces on the solid (empty vectors: no coupling force).
+  virtual void advance(const proto::StepBegin& s, const proto::SolidInput& in) = 0;
+};
+
+class FiberPort : public SolverPort {
+ public:
+  virtual proto::FiberLayout layout() const = 0;
+  // Root poses of attached fibers at t^0, before the initial state is taken (coupled runs).
+  virtual void set_initial_roots(const std::vector<std::vector<double>>& root_pose) = 0;
+  virtual void state(proto::FiberState& s) const = 0;  // X^n, X^(n-1), root loads
+  virtual void advance(const proto::StepBegin& s, const proto::FiberInput& in) = 0;
+};
+
+// Run the solver to the end of the scene (coupled or standalone), write summary.json and the
+// effective scene in a standalone run. Collective over the job.
+void serve(Runtime& rt, FluidPort& port);
+void serve(Runtime& rt, SolidPort& port);
+void serve(Runtime& rt, FiberPort& port);
+
+// The time of step n: t^n = n dt (no accumulated round-off).
+inline double step_time(const CommonSettings& s, long n) { return static_cast<double>(n) * s.dt; }
+
+// Whether fields are written after step n: at every multiple of the output interval (and at the
+// last step); never when the interval is 0.
+bool is_output_step(const CommonSettings& s, long n);
+
+// Write out_dir/summary.json (atomically).
+void write_summary(const Runtime& rt, const nlohmann::json& summary);
+
+}  // namespace fsi

@@ -1,0 +1,290 @@
+// The coupling protocol: every message that travels between the coupler and a solver, its
+// layout, units and sign, and the version. common/PROTOCOL.md is the prose version of this file
+// (message order per step, who sends what). Messages are packed into a byte buffer: a header
+// (magic, version, tag, step) then the fields in declaration order; a vector is its length
+// (int64) followed by its elements; a string is its length then its bytes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "error.hpp"
+
+namespace fsi::proto {
+
+// Bump on any change of a message's layout or of the message order.
+inline constexpr std::int32_t kVersion = 1;
+inline constexpr std::uint32_t kMagic = 0x4d495346;  // "FSIM"
+
+enum class Tag : std::int32_t {
+  // set-up, once, in this order
+  grid_info = 1,     // fluid  -> coupler
+  body_meshes = 2,   // solid  -> coupler
+  fiber_layout = 3,  // fiber  -> coupler
+  effective_scene = 4,  // solver -> coupler
+  // every step
+  step_begin = 10,   // coupler -> each solver
+  fluid_input = 11,  // coupler -> fluid
+  fluid_output = 12, // fluid   -> coupler
+  solid_input = 13,  // coupler -> solid
+  solid_state = 14,  // solid   -> coupler (also once at set-up: the initial state)
+  fiber_input = 15,  // coupler -> fiber
+  fiber_state = 16,  // fiber   -> coupler (also once at set-up: the initial state)
+  // end
+  final_report = 20, // solver -> coupler
+};
+const char* tag_name(Tag t);
+
+// ---- byte buffer ------------------------------------------------------------------------------
+
+class Writer {
+ public:
+  template <class T>
+  void put(const T& x) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    append(&x, sizeof(T));
+  }
+  template <class T>
+  void put(const std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    put(static_cast<std::int64_t>(v.size()));
+    append(v.data(), v.size() * sizeof(T));
+  }
+  void put(const std::string& s);
+  const std::vector<std::byte>& bytes() const { return m_bytes; }
+  std::vector<std::byte>& bytes() { return m_bytes; }
+
+ private:
+  void append(const void* p, std::size_t n) {
+    const std::size_t old = m_bytes.size();
+    m_bytes.resize(old + n);
+    if (n) std::memcpy(m_bytes.data() + old, p, n);
+  }
+  std::vector<std::byte> m_bytes;
+};
+
+class Reader {
+ public:
+  Reader(const std::byte* data, std::size_t size) : m_data(data), m_size(size) {}
+  template <class T>
+  void get(T& x) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    need(sizeof(T));
+    std::memcpy(&x, m_data + m_pos, sizeof(T));
+    m_pos += sizeof(T);
+  }
+  template <class T>
+  void get(std::vector<T>& v) {
+    std::int64_t n = 0;
+    get(n);
+    if (n < 0 || static_cast<std::size_t>(n) > (m_size - m_pos) / sizeof(T))
+      fail("protocol error: vector length {} does not fit the message", n);
+    v.resize(static_cast<std::size_t>(n));
+    std::memcpy(v.data(), m_data + m_pos, v.size() * sizeof(T));
+    m_pos += v.size() * sizeof(T);
+  }
+  void get(std::string& s);
+  bool done() const { return m_pos == m_size; }
+
+ private:
+  void need(std::size_t n) const {
+    if (m_size - m_pos < n) fail("protocol error: message truncated");
+  }
+  const std::byte* m_data;
+  std::size_t m_size;
+  std::size_t m_pos = 0;
+};
+
+// ---- messages -----------------------------------------------------------------------------------
+// Index conventions on the fluid's MAC grid with nx x ny cells: a u-face (i, j) lies at
+// (x_face[i], y_centre[j]), i in [0, nu) with nu = nx if x is periodic else nx + 1, flat index
+// i + nu*j; a v-face (i, j) lies at (x_centre[i], y_face[j]), j in [0, nv) with nv = ny if y is
+// periodic else ny + 1, flat index i + nx*j. Vectors of points are interleaved (x0, y0, x1, y1, ...).
+// All quantities are in the scene's units.
+
+struct GridInfo {  // fluid -> coupler, once
+  static constexpr Tag tag = Tag::grid_info;
+  std::int32_t nx = 0, ny = 0;
+  std::int32_t periodic_x = 0, periodic_y = 0;
+  std::vector<double> x_face;  // nx + 1 face coordinates (cell i spans x_face[i]..x_face[i+1])
+  std::vector<double> y_face;  // ny + 1
+  double density = 0;          // rho_f
+  void pack(Writer& w) const;
+  void unpack(Reader& r);
+};
+
+struct BodyMesh {
+  std::string name;
+  std::int32_t kind = 0;           // 0 elastic, 1 rigid fixed, 2 rigid with prescribed motion
+  std::vector<double> x_ref;       // reference node coordinates, 2 per node
+  std::vector<std::int32_t> tri;   // 3 node indices per triangle, counter-clockwise
+  std::vector<std::int32_t> edges; // surface edges, 2 node indices each, body on the left
+};
+
+struct BodyMeshes {  // solid -> coupler, once
+  static constexpr Tag tag = Tag::body_meshes;
+  std::vector<BodyMesh> bodies;
+  void pack(Writer& w) const;
+  void unpack(Reader& r);
+};
+
+struct FiberLayout1 {
+  std::string name;
+  std::int32_t markers = 0;      // marker count (segments + 1)
+  double ds = 0;                 // arclength spacing
+  std::int32_t root = 0;         // 0 free/clamped/hinged at a fixed point, 1 attached to a body
+  std::string body;              // attached: body name
+  std::int32_t edge = -1;        // attached: surface edge index of that body
+  double edge_s = 0;             // attached: parameter along the edge, 0..1
+};
+
+struct FiberLayout {  // fiber -> coupler, once
+  static constexpr Tag tag = Tag::fiber_layout;
+  std::vector<FiberLayout1> fibers;
+  void pack(Writer& w) const;
+  void unpack(Reader& r);
+};
+
+struct Text {  // effective_scene, final_report: a TOML or JSON document
+  Tag tag = Tag::effective_scene;
+  std::string text;
+  void pack(Writer& w) const;
+  void unpack(Reader& r);
+};
+
+enum class Action : std::int32_t { step = 0, stop = 1 };
+
+struct StepBegin {  // coupler -> each solver, every step
+  static constexpr Tag tag = Tag::step_begin;
+  std::int64_t step = 0;  // n: the step advances t^n -> t^n + dt
+  double time = 0;        // t^n
+  double dt = 0;
+  Action action = Action::step;
+  void pack(Writer& w) const;
+  void unpack(Reader& r);
+};
+
+// Solid on faces: for each listed face, the solid volume fraction alpha in [0, 1] of its
+// control volume and the mean solid velocity component over the solid part of it.
+struct FaceSolid {
+  std::vector<std::int32_t> index;
+  std::vector<double> alpha;
+  std::vector<double> velocity;
+};
+
+// A sparse body force per unit volume on faces (force on the fluid).
+struct FaceForce {
+  std::vector<std::int32_t> index;
+  std::vector<double> force;
+};
+
+struct FluidInput {  // coupler -> fluid, every step
+  static constexpr Tag tag = Tag::fluid_input;
+  FaceSolid solid_u, solid_v;   // immersed solid: alpha, mean solid velocity
+  FaceForce force_u, force_v;   // fibers' spread force f_f, applied in the predictor
+  std::vector<std::int32_t> sample_u, sample_v;  // faces whose u^(n+1) the coupler wants back
+  void pack(Writer& w) const;
+  void unpack(Reader& r);
+};
+
+struct FluidOutput {  // fluid -> coupler, every step
+  static constexpr Tag tag = Tag::fluid_output;
+  // f_s = rho_f alpha (u_s - u~)/dt on solid_u / solid_v's faces, same order: force per unit
+  // volume ON THE FLUID.
+  std::vector<double> fs_u, fs_v;
+  std::vector<double> u_sample, v_sample;  // u^(n+1) on sample_u / sample_v
+  double cfl = 0, max_div = 0, kinetic_energy = 0;
+  void pack(Writer& w) const;
+  void unpack(Reader& r);
+};
+
+struct SolidInput {  // coupler -> solid, every step
+  static constexpr Tag tag = Tag::solid_input;
+  // per body: nodal forces ON THE SOLID (2 per node), the exact reaction of f_s plus the
+  // fibers' root loads as equivalent nodal forces. Empty for rigid bodies.
+  std::vector<std::vector<double>> force;
+  void pack(Writer& w) const;
+  void unpack(Reader& r);
+};
+
+struct SolidState {  // solid -> coupler, at set-up and after every step
+  static constexpr Tag tag = Tag::solid_state;
+  double time = 0;
+  std::vector<std::vector<double>> x, v;  // per body: current node positions, velocities
+  void pack(Writer& w) const;
+  void unpack(Reader& r);
+};
+
+struct FiberInput {  // coupler -> fiber, every step
+  static constexpr Tag tag = Tag::fiber_input;
+  // per fiber: feedback force per unit length ON THE FIBER at each marker (2 per marker)
+  std::vector<std::vector<double>> force;
+  // per fiber: root pose at t^(n+1) for attached fibers (x, y, dx, dy: position, unit
+  // direction into the fiber); empty for others
+  std::vector<std::vector<double>> root_pose;
+  void pack(Writer& w) const;
+  void unpack(Reader& r);
+};
+
+struct FiberState {  // fiber -> coupler, at set-up and after every step
+  static constexpr Tag tag = Tag::fiber_state;
+  double time = 0;
+  std::vector<std::vector<double>> x, x_old;  // per fiber: X^n, X^(n-1)
+  // per fiber: load the fiber exerts ON ITS SUPPORT at the root: (fx, fy, moment about the root)
+  std::vector<double> root_load;
+  void pack(Writer& w) const;
+  void unpack(Reader& r);
+};
+
+// Whole-message packing with the header; unpack checks magic, version, tag, and that every byte
+// was read.
+template <class M>
+std::vector<std::byte> pack_message(const M& m, std::int64_t step);
+template <class M>
+void unpack_message(const std::vector<std::byte>& bytes, M& m, std::int64_t* step = nullptr);
+
+struct Header {
+  std::uint32_t magic = kMagic;
+  std::int32_t version = kVersion;
+  Tag tag{};
+  std::int32_t pad = 0;
+  std::int64_t step = 0;
+};
+
+template <class M>
+Tag message_tag(const M& m) {
+  if constexpr (std::is_same_v<M, Text>) return m.tag;
+  else return M::tag;
+}
+
+template <class M>
+std::vector<std::byte> pack_message(const M& m, std::int64_t step) {
+  Writer w;
+  Header h;
+  h.tag = message_tag(m);
+  h.step = step;
+  w.put(h);
+  m.pack(w);
+  return std::move(w.bytes());
+}
+
+template <class M>
+void unpack_message(const std::vector<std::byte>& bytes, M& m, std::int64_t* step) {
+  Reader r(bytes.data(), bytes.size());
+  Header h;
+  r.get(h);
+  if (h.magic != kMagic) fail("protocol error: bad message magic {:#x}", h.magic);
+  if (h.version != kVersion)
+    fail("protocol error: message of version {}, expected {}", h.version, kVersion);
+  if (h.tag != message_tag(m))
+    fail("protocol error: expected message '{}', got '{}'", tag_name(message_tag(m)), tag_name(h.tag));
+  m.unpack(r);
+  if (!r.done()) fail("protocol error: message '{}' has trailing bytes", tag_name(h.tag));
+  if (step) *step = h.step;
+}
+
+}  // namespace fsi::proto

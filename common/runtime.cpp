@@ -1,0 +1,367 @@
+// MPMD start-up, handshake, links and the error funnel (see runtime.hpp).
+#include "runtime.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <thread>
+
+namespace fsi {
+
+namespace {
+
+constexpr const char* kRoleNames[kRoleCount] = {"fluid", "solid", "fiber", "coupler"};
+
+// What every process announces at start-up, over MPI_COMM_WORLD. Fixed size and layout so that
+// even a process of another protocol version can be read and refused with a clear message.
+struct Announce {
+  std::uint32_t magic;
+  std::int32_t version;
+  std::int32_t role;
+  std::int32_t appnum;
+  std::int32_t local_size;
+  std::int32_t world_rank;
+  std::uint64_t scene_hash;
+  std::int32_t needed;
+  std::int32_t pad;
+};
+
+// Wait for a request without spinning the core: test, yield, then sleep with a growing interval
+// (at most 200 us, so a message is picked up within that of its arrival).
+void wait_politely(MPI_Request& req) {
+  int done = 0;
+  MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+  for (int k = 0; !done; ++k) {
+    if (k < 20) std::this_thread::yield();
+    else std::this_thread::sleep_for(std::chrono::microseconds(std::min(200, 5 * (k - 19))));
+    MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+  }
+}
+
+}  // namespace
+
+const char* role_name(Role r) { return kRoleNames[static_cast<int>(r)]; }
+
+std::optional<Role> role_from_name(std::string_view name) {
+  for (int i = 0; i < kRoleCount; ++i)
+    if (name == kRoleNames[i]) return static_cast<Role>(i);
+  return std::nullopt;
+}
+
+std::string RoleSet::names() const {
+  std::string s;
+  for (int i = 0; i < kRoleCount; ++i)
+    if (need[i]) s += (s.empty() ? "" : ", ") + std::string(kRoleNames[i]);
+  return s.empty() ? "none" : s;
+}
+
+RoleSet roles_needed(const SceneTable& root) {
+  RoleSet r;
+  r.need[0] = root.has("fluid");
+  r.need[1] = root.has("solid");
+  r.need[2] = root.has("fiber");
+  r.need[3] = r.solver_count() >= 2;
+  if (r.solver_count() == 0)
+    root.fail_table("the scene has none of the tables [fluid], [solid], [fiber]: nothing to run");
+  if (root.has("coupler") && r.solver_count() < 2)
+    root.fail("coupler", "is given, but the scene has only one solver ([" + r.names() +
+                             "]): nothing to couple");
+  return r;
+}
+
+Options parse_options(int argc, char** argv, const char* role) {
+  Options o;
+  const std::string usage =
+      fmt::format("usage: {} SCENE.toml [--out ROOT | --out-dir DIR] [--overwrite]", role);
+  std::vector<std::string> positional;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--overwrite") o.overwrite = true;
+    else if (a == "--out" || a == "--out-dir") {
+      if (i + 1 >= argc) throw InputError(fmt::format("{} needs a folder; {}", a, usage));
+      if (a == "--out") o.out_root = argv[++i];
+      else o.out_dir = std::filesystem::path(argv[++i]);
+    } else if (a == "--help" || a == "-h") throw InputError(usage);
+    else if (a.starts_with("--")) throw InputError(fmt::format("unknown option '{}'; {}", a, usage));
+    else positional.push_back(a);
+  }
+  if (positional.size() != 1)
+    throw InputError(fmt::format("expected one scene file, got {}; {}", positional.size(), usage));
+  o.scene = positional[0];
+  return o;
+}
+
+CommonSettings read_common(const SceneTable& root) {
+  CommonSettings s;
+  const auto scene = root.optional_table("scene");
+  const std::string stem = root.file().stem().string();
+  if (scene) {
+    s.name = scene->string("name", stem);
+    scene->string("description", "");
+    scene->finish();
+  } else {
+    s.name = stem;
+  }
+  if (s.name.empty() || s.name.find_first_of("/\\ ") != std::string::npos || s.name[0] == '.')
+    root.table("scene").fail("name", fmt::format("must be a plain folder name, got \"{}\"", s.name));
+
+  const auto time = root.table("time");
+  s.dt = time.positive("dt");
+  s.t_end = time.positive("t_end");
+  const double n = s.t_end / s.dt;
+  s.steps = std::lround(n);
+  if (std::abs(static_cast<double>(s.steps) - n) > 1e-9 * n) s.steps = static_cast<long>(std::ceil(n));
+  if (s.steps < 1) s.steps = 1;
+  time.finish();
+
+  if (const auto out = root.optional_table("output")) {
+    s.output_interval = out->non_negative("interval", 0.0);
+    s.progress_every = out->integer("progress", 0);
+    if (s.progress_every < 0) out->fail("progress", fmt::format("must be >= 0, got {}", s.progress_every));
+    out->finish();
+  }
+  if (const auto test = root.optional_table("test")) {
+    const std::vector<std::string> roles(kRoleNames, kRoleNames + kRoleCount);
+    if (test->has("fail_role")) {
+      s.fail_role = test->choice("fail_role", roles);
+      s.fail_step = test->integer("fail_step");
+      if (s.fail_step < 0) test->fail("fail_step", fmt::format("must be >= 0, got {}", s.fail_step));
+    }
+    if (test->has("bad_protocol_version"))
+      s.bad_version_role = test->choice("bad_protocol_version", roles);
+    test->finish();
+  }
+  return s;
+}
+
+std::filesystem::path choose_out_dir(const std::filesystem::path& root, const std::string& name,
+                                     bool overwrite) {
+  namespace fs = std::filesystem;
+  fs::path dir = root / name;
+  if (overwrite) {
+    fs::remove_all(dir);
+  } else {
+    for (int k = 2; fs::exists(dir); ++k) dir = root / fmt::format("{}-{}", name, k);
+  }
+  fs::create_directories(dir);
+  return dir;
+}
+
+// ---- Link -------------------------------------------------------------------------------------
+
+void Link::send_bytes(const std::vector<std::byte>& bytes, proto::Tag tag) {
+  MPI_Request req;
+  MPI_Isend(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, 0, static_cast<int>(tag), m_comm,
+            &req);
+  wait_politely(req);
+  m_sent += bytes.size();
+}
+
+std::vector<std::byte> Link::recv_bytes(proto::Tag expected) {
+  int flag = 0;
+  MPI_Message msg;
+  MPI_Status status;
+  MPI_Improbe(0, MPI_ANY_TAG, m_comm, &flag, &msg, &status);
+  for (int k = 0; !flag; ++k) {
+    if (k < 20) std::this_thread::yield();
+    else std::this_thread::sleep_for(std::chrono::microseconds(std::min(200, 5 * (k - 19))));
+    MPI_Improbe(0, MPI_ANY_TAG, m_comm, &flag, &msg, &status);
+  }
+  if (status.MPI_TAG != static_cast<int>(expected))
+    fail("protocol error: expected message '{}' from {}, got '{}'", proto::tag_name(expected),
+         role_name(m_peer), proto::tag_name(static_cast<proto::Tag>(status.MPI_TAG)));
+  int count = 0;
+  MPI_Get_count(&status, MPI_BYTE, &count);
+  std::vector<std::byte> bytes(static_cast<std::size_t>(count));
+  MPI_Mrecv(bytes.data(), count, MPI_BYTE, &msg, MPI_STATUS_IGNORE);
+  m_received += bytes.size();
+  return bytes;
+}
+
+// ---- Runtime ----------------------------------------------------------------------------------
+
+Link& Runtime::coupler_link() {
+  if (!m_links[static_cast<int>(Role::coupler)]) fail("{}: no coupler in this run", name());
+  return *m_links[static_cast<int>(Role::coupler)];
+}
+
+Link& Runtime::link(Role solver) {
+  if (!m_links[static_cast<int>(solver)]) fail("{}: no link to {}", name(), role_name(solver));
+  return *m_links[static_cast<int>(solver)];
+}
+
+double Runtime::wall_seconds() const { return MPI_Wtime() - m_t0; }
+
+void Runtime::check_fault(long step) const {
+  if (m_settings.fail_role == name() && step == m_settings.fail_step)
+    fail("test fault injected at step {} (test.fail_role = \"{}\")", step, name());
+}
+
+void abort_job(const char* role, const std::string& message) {
+  std::fprintf(stderr, "[%s] ERROR: %s\n", role, message.c_str());
+  std::fflush(stderr);
+  int initialized = 0, finalized = 0;
+  MPI_Initialized(&initialized);
+  MPI_Finalized(&finalized);
+  if (initialized && !finalized) MPI_Abort(MPI_COMM_WORLD, 1);
+  std::_Exit(1);
+}
+
+namespace {
+
+// Start-up checks on what every process announced; the same verdict on every process.
+void check_job(const Runtime& rt, const std::vector<Announce>& all, const RoleSet& need,
+               std::uint64_t my_hash) {
+  std::array<int, kRoleCount> appnum;
+  appnum.fill(-1);
+  for (const auto& a : all) {
+    if (a.magic != 0x31495346u)  // "FSI1"
+      fail("process {} of the job is not a program of this project", a.world_rank);
+    if (a.role < 0 || a.role >= kRoleCount) fail("process {} announced an unknown role", a.world_rank);
+    const char* who = kRoleNames[a.role];
+    if (a.version != proto::kVersion)
+      fail("protocol version mismatch: {} speaks version {}, {} speaks version {}; rebuild the "
+           "programs from one source tree",
+           who, a.version, rt.name(), proto::kVersion);
+    if (a.scene_hash != my_hash)
+      fail("scene mismatch: {} read a scene file with different contents than {} (same path on "
+           "every process, same file?)",
+           who, rt.name());
+    if (appnum[a.role] >= 0 && appnum[a.role] != a.appnum)
+      fail("role '{}' was launched twice (programs {} and {} of the mpirun line); launch each "
+           "program once",
+           who, appnum[a.role], a.appnum);
+    appnum[a.role] = a.appnum;
+    if (a.local_size != 1)
+      fail("{} was launched on {} ranks; each program runs on 1 rank (-n 1)", who, a.local_size);
+  }
+  std::vector<std::string> missing, launched;
+  for (int r = 0; r < kRoleCount; ++r) {
+    if (appnum[r] >= 0) launched.push_back(kRoleNames[r]);
+    if (need.need[r] && appnum[r] < 0) missing.push_back(kRoleNames[r]);
+  }
+  if (!missing.empty())
+    fail("the scene needs the program(s) {}, which were not launched (launched: {}; the scene "
+         "needs: {})",
+         fmt::join(missing, ", "), fmt::join(launched, ", "), need.names());
+}
+
+}  // namespace
+
+int run_program(Role role, int argc, char** argv, const std::function<void(Runtime&)>& body) {
+  MPI_Init(&argc, &argv);
+  Runtime rt;
+  rt.m_role = role;
+  rt.m_t0 = MPI_Wtime();
+  try {
+    int world_rank = 0, world_size = 1;
+    MPI_Comm_rank(MPI_COMM_WORLD, &world_rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &world_size);
+    int* appnum_attr = nullptr;
+    int flag = 0;
+    MPI_Comm_get_attr(MPI_COMM_WORLD, MPI_APPNUM, &appnum_attr, &flag);
+    const int appnum = flag ? *appnum_attr : 0;
+    MPI_Comm local;
+    MPI_Comm_split(MPI_COMM_WORLD, appnum, world_rank, &local);
+    int local_size = 1;
+    MPI_Comm_size(local, &local_size);
+
+    const Options opts = parse_options(argc, argv, rt.name());
+    rt.m_scene = std::make_unique<Scene>(opts.scene);
+    const SceneTable root = rt.m_scene->root();
+    rt.m_roles = roles_needed(root);
+    rt.m_settings = read_common(root);
+    for (const char* k : {"fluid", "solid", "fiber", "coupler"}) root.skip(k);
+    root.finish();
+
+    // Handshake: who is here, which protocol, which scene.
+    Announce me{0x31495346u,
+                rt.m_settings.bad_version_role == rt.name() ? proto::kVersion + 1000 : proto::kVersion,
+                static_cast<int>(role),
+                appnum,
+                local_size,
+                world_rank,
+                rt.m_scene->hash(),
+                rt.m_roles[role] ? 1 : 0,
+                0};
+    std::vector<Announce> all(static_cast<std::size_t>(world_size));
+    MPI_Allgather(&me, sizeof(Announce), MPI_BYTE, all.data(), sizeof(Announce), MPI_BYTE,
+                  MPI_COMM_WORLD);
+    if (me.version != proto::kVersion)
+      fail("protocol version {} announced (test.bad_protocol_version); this build speaks {}",
+           me.version, proto::kVersion);
+    check_job(rt, all, rt.m_roles, rt.m_scene->hash());
+
+    // The processes the scene needs carry on in `job`; the others leave cleanly.
+    MPI_Comm job;
+    MPI_Comm_split(MPI_COMM_WORLD, rt.m_roles[role] ? 0 : MPI_UNDEFINED, world_rank, &job);
+    if (!rt.m_roles[role]) {
+      std::fprintf(stderr, "[%s] not needed by scene '%s' (it needs %s): exiting\n", rt.name(),
+                   rt.m_settings.name.c_str(), rt.m_roles.names().c_str());
+      MPI_Finalize();
+      return 0;
+    }
+    int job_rank = 0;
+    MPI_Comm_rank(job, &job_rank);
+
+    // Output folder: chosen by the first process of the job, the same for all.
+    std::string dir;
+    if (job_rank == 0)
+      dir = (opts.out_dir ? [&] {
+              if (std::filesystem::exists(*opts.out_dir) && !opts.overwrite &&
+                  !std::filesystem::is_empty(*opts.out_dir))
+                throw InputError(fmt::format(
+                    "output folder '{}' exists and is not empty; pass --overwrite to replace it",
+                    opts.out_dir->string()));
+              if (opts.overwrite) std::filesystem::remove_all(*opts.out_dir);
+              std::filesystem::create_directories(*opts.out_dir);
+              return *opts.out_dir;
+            }()
+                           : choose_out_dir(opts.out_root, rt.m_settings.name, opts.overwrite))
+                .string();
+    long len = static_cast<long>(dir.size());
+    MPI_Bcast(&len, 1, MPI_LONG, 0, job);
+    dir.resize(static_cast<std::size_t>(len));
+    MPI_Bcast(dir.data(), static_cast<int>(len), MPI_CHAR, 0, job);
+    rt.m_out_dir = dir;
+
+    // Intercommunicators: the coupler with each solver, in the order fluid, solid, fiber.
+    if (rt.coupled()) {
+      std::array<int, kRoleCount> job_rank_of;
+      job_rank_of.fill(-1);
+      std::vector<int> ranks(static_cast<std::size_t>(world_size), -1);
+      MPI_Allgather(&role, 1, MPI_INT, ranks.data(), 1, MPI_INT, job);
+      int job_size = 0;
+      MPI_Comm_size(job, &job_size);
+      for (int k = 0; k < job_size; ++k)
+        if (job_rank_of[ranks[k]] < 0) job_rank_of[ranks[k]] = k;
+      const int tag_base = 7100;
+      if (role == Role::coupler) {
+        for (Role s : {Role::fluid, Role::solid, Role::fiber}) {
+          if (!rt.m_roles[s]) continue;
+          MPI_Comm inter;
+          MPI_Intercomm_create(local, 0, job, job_rank_of[static_cast<int>(s)],
+                               tag_base + static_cast<int>(s), &inter);
+          rt.m_links[static_cast<int>(s)] = std::make_unique<Link>(inter, s);
+        }
+      } else {
+        MPI_Comm inter;
+        MPI_Intercomm_create(local, 0, job, job_rank_of[static_cast<int>(Role::coupler)],
+                             tag_base + static_cast<int>(role), &inter);
+        rt.m_links[static_cast<int>(Role::coupler)] = std::make_unique<Link>(inter, Role::coupler);
+      }
+    }
+
+    body(rt);
+  } catch (const std::exception& e) {
+    abort_job(rt.name(), e.what());
+  } catch (...) {
+    abort_job(rt.name(), "unknown exception");
+  }
+  MPI_Finalize();
+  return 0;
+}
+
+}  // namespace fsi

@@ -1,0 +1,131 @@
+// The MPMD runtime every program starts with. run_program() initialises MPI, reads the scene,
+// finds the programs of the job by name (never by position), checks the protocol version and the
+// scene's identity on every process, picks the output folder, links the coupler to each solver
+// with an intercommunicator, runs the program's body, and funnels every error into
+// "[role] ERROR: ..." on stderr followed by MPI_Abort(MPI_COMM_WORLD, 1).
+#pragma once
+
+#include <mpi.h>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "protocol.hpp"
+#include "scene.hpp"
+
+namespace fsi {
+
+enum class Role : int { fluid = 0, solid = 1, fiber = 2, coupler = 3 };
+inline constexpr int kRoleCount = 4;
+const char* role_name(Role r);
+std::optional<Role> role_from_name(std::string_view name);
+
+// Which programs a scene needs: a solver when its top-level table is present, the coupler when
+// two or more solvers are.
+struct RoleSet {
+  std::array<bool, kRoleCount> need{};
+  bool operator[](Role r) const { return need[static_cast<int>(r)]; }
+  int solver_count() const { return need[0] + need[1] + need[2]; }
+  std::string names() const;  // "fluid, solid"
+};
+RoleSet roles_needed(const SceneTable& root);
+
+// Command line shared by all programs: PROGRAM SCENE.toml [--out DIR] [--overwrite]
+struct Options {
+  std::filesystem::path scene;
+  std::filesystem::path out_root = "out";
+  std::optional<std::filesystem::path> out_dir;  // --out-dir: exactly this folder
+  bool overwrite = false;
+};
+Options parse_options(int argc, char** argv, const char* role);
+
+// The sections every program reads: [scene], [time], [output], [test].
+struct CommonSettings {
+  std::string name;         // scene.name: names the output folder
+  double dt = 0;            // time.dt > 0
+  double t_end = 0;         // time.t_end > 0
+  long steps = 0;           // number of steps: t_end / dt rounded up
+  double output_interval = 0;  // output.interval: field output every this much time; 0 = none
+  long progress_every = 0;     // output.progress: 0 = automatic
+  // [test]: fault switches used by the test suite only
+  std::string fail_role;    // test.fail_role: this program fails ...
+  long fail_step = -1;      // ... at the start of this step
+  std::string bad_version_role;  // test.bad_protocol_version: this program announces a wrong version
+};
+CommonSettings read_common(const SceneTable& root);
+
+// A point-to-point link to another program (an intercommunicator with one rank on each side).
+// send/recv wait politely (test, then sleep with back-off) so that a program waiting for a
+// message leaves the core to the one that computes.
+class Link {
+ public:
+  Link(MPI_Comm inter, Role peer) : m_comm(inter), m_peer(peer) {}
+  Role peer() const { return m_peer; }
+  void send_bytes(const std::vector<std::byte>& bytes, proto::Tag tag);
+  std::vector<std::byte> recv_bytes(proto::Tag expected);
+  template <class M>
+  void send(const M& m, std::int64_t step = 0) {
+    send_bytes(proto::pack_message(m, step), proto::message_tag(m));
+  }
+  template <class M>
+  void recv(M& m, std::int64_t* step = nullptr) {
+    const auto bytes = recv_bytes(proto::message_tag(m));
+    proto::unpack_message(bytes, m, step);
+  }
+  std::uint64_t bytes_sent() const { return m_sent; }
+  std::uint64_t bytes_received() const { return m_received; }
+
+ private:
+  MPI_Comm m_comm;
+  Role m_peer;
+  std::uint64_t m_sent = 0, m_received = 0;
+};
+
+class Runtime {
+ public:
+  Role role() const { return m_role; }
+  const char* name() const { return role_name(m_role); }
+  const Scene& scene() const { return *m_scene; }
+  SceneTable root() const { return m_scene->root(); }
+  const CommonSettings& settings() const { return m_settings; }
+  const RoleSet& roles() const { return m_roles; }
+  const std::filesystem::path& out_dir() const { return m_out_dir; }
+  // True when a coupler runs: solvers then talk to it through coupler_link().
+  bool coupled() const { return m_roles[Role::coupler]; }
+  Link& coupler_link();
+  // On the coupler: the link to a solver the scene needs.
+  Link& link(Role solver);
+  bool has_link(Role r) const { return m_links[static_cast<int>(r)] != nullptr; }
+  double wall_seconds() const;  // since start
+  // The test-only fault switch: throws when this program is told to fail at `step`.
+  void check_fault(long step) const;
+
+ private:
+  friend int run_program(Role, int, char**, const std::function<void(Runtime&)>&);
+  Role m_role{};
+  std::unique_ptr<Scene> m_scene;
+  CommonSettings m_settings;
+  RoleSet m_roles;
+  std::filesystem::path m_out_dir;
+  std::array<std::unique_ptr<Link>, kRoleCount> m_links;
+  double m_t0 = 0;
+};
+
+// The body of a program's main. Returns the process exit code (0), or aborts the job on error.
+int run_program(Role role, int argc, char** argv, const std::function<void(Runtime&)>& body);
+
+// Print "[role] ERROR: message" and abort the whole job.
+[[noreturn]] void abort_job(const char* role, const std::string& message);
+
+// Choose the output folder under `root` for scene `name`: root/name, or root/name-2, -3, ... if
+// that exists (never silently overwritten), or root/name emptied when `overwrite`.
+std::filesystem::path choose_out_dir(const std::filesystem::path& root, const std::string& name,
+                                     bool overwrite);
+
+}  // namespace fsi

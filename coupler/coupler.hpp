@@ -1,0 +1,46 @@
+// The coupler: the clock of a coupled run and every Euler-Lagrange transfer between the fluid,
+// the solids and the fibers (DESIGN.md §3, §4.4). It knows the fluid only through the grid the
+// fluid describes at set-up, and the solids and fibers only through their meshes and markers.
+#pragma once
+
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "protocol.hpp"
+#include "runtime.hpp"
+
+namespace coupler {
+
+namespace proto = fsi::proto;
+
+class Coupler {
+ public:
+  explicit Coupler(fsi::Runtime& rt);
+  // Set-up exchange, every step of the scene, then the end of the run and summary.json.
+  // Collective over the job.
+  void run();
+
+ private:
+  void setup();
+  void step(long n);
+  void finish();
+  bool has(fsi::Role r) const { return m_rt.roles()[r]; }
+
+  fsi::Runtime& m_rt;
+  // What the solvers described at set-up.
+  proto::GridInfo m_grid;
+  proto::BodyMeshes m_meshes;
+  proto::FiberLayout m_layout;
+  // Latest states and the messages of a step (kept to reuse their storage).
+  proto::SolidState m_solid;
+  proto::FiberState m_fiber;
+  proto::FluidInput m_fluid_in;
+  proto::FluidOutput m_fluid_out;
+  proto::SolidInput m_solid_in;
+  proto::FiberInput m_fiber_in;
+  std::map<std::string, std::string> m_effective;  // role -> its effective scene (TOML)
+  double m_t_start = 0;
+};
+
+}  // namespace coupler
