@@ -65,7 +65,10 @@ std::string object_name(std::string_view name) {
 
 std::string shape_text(const H5Shape& shape) {
   std::string s = "{";
-  for (std::size_t k = 0; k < shape.size(); ++k) s += (k ? ", " : "") + std::to_string(shape[k]);
+  for (std::size_t k = 0; k < shape.size(); ++k) {
+    if (k) s += ", ";
+    s += std::to_string(shape[k]);
+  }
   return s + "}";
 }
 
@@ -113,13 +116,17 @@ std::string h5_step_group(long step) { return fmt::format("/step_{:06d}", step);
 H5File::H5File(const std::filesystem::path& path, Mode mode) : m_path(path) {
   silence_hdf5();
   m_is_writable = mode != Mode::read_only;
+  // No file locks: ParaView or a script may read the file while the run writes it (each write
+  // is flushed, so a reader sees the steps completed so far).
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  H5Pset_file_locking(fapl.get(), false, true);
   if (mode == Mode::truncate) {
-    m_id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    m_id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
     if (m_id < 0) raise("cannot create the file", "");
   } else {
     if (!std::filesystem::exists(path))
       throw Error(fmt::format("HDF5: cannot open {}: no such file", path.string()));
-    m_id = H5Fopen(path.c_str(), m_is_writable ? H5F_ACC_RDWR : H5F_ACC_RDONLY, H5P_DEFAULT);
+    m_id = H5Fopen(path.c_str(), m_is_writable ? H5F_ACC_RDWR : H5F_ACC_RDONLY, fapl.get());
     if (m_id < 0) raise("cannot open the file", "");
   }
 }
@@ -428,6 +435,20 @@ H5Shape H5File::shape(std::string_view name) const {
   if (!set.ok()) raise("no dataset", path);
   Handle space(H5Dget_space(set.get()), H5Sclose);
   return dataspace_shape(space.get());
+}
+
+std::string H5File::type_name(std::string_view name) const {
+  std::string path = object_name(name);
+  Handle set(H5Dopen2(m_id, path.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!set.ok()) raise("no dataset", path);
+  Handle type(H5Dget_type(set.get()), H5Tclose);
+  std::size_t bits = 8 * H5Tget_size(type.get());
+  switch (H5Tget_class(type.get())) {
+    case H5T_FLOAT: return fmt::format("float{}", bits);
+    case H5T_INTEGER:
+      return fmt::format("{}int{}", H5Tget_sign(type.get()) == H5T_SGN_NONE ? "u" : "", bits);
+    default: return "other";
+  }
 }
 
 template <class T>

@@ -85,6 +85,8 @@ class H5File {
 
   // Reading back (checkpoints, tests): the dataset converted to the asked type, and its shape.
   H5Shape shape(std::string_view name) const;
+  // The stored element type: "float64", "float32", "int32", "int64", "uint8" ... or "other".
+  std::string type_name(std::string_view name) const;
   std::vector<double> read_doubles(std::string_view name) const;
   std::vector<int> read_ints(std::string_view name) const;
   std::vector<std::int64_t> read_int64s(std::string_view name) const;

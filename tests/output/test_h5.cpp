@@ -43,6 +43,9 @@ TEST_CASE("datasets of doubles and ints round trip with their shapes", "[h5]") {
   CHECK(h5.read_doubles("/step_000012/u") == u);  // bitwise: no precision lost
   CHECK(h5.shape("mesh/triangles") == fsi::H5Shape{2, 3});
   CHECK(h5.read_ints("/mesh/triangles") == tri);
+  CHECK(h5.type_name("/step_000012/u") == "float64");
+  CHECK(h5.type_name("/mesh/triangles") == "int32");
+  CHECK(h5.type_name("counts") == "int64");
   CHECK(h5.read_int64s("counts") == big);
   CHECK(h5.read_doubles("counts")[1] == -7.0);
 }

@@ -1,0 +1,111 @@
+// XDMF side files: the light XML that lets ParaView open the heavy data of an .h5 file as a time
+// series. One XdmfWriter describes one temporal collection of one kind of grid (a 2D
+// rectilinear grid, a triangle mesh, or a set of polylines); after each appended step the whole
+// file is rewritten through a temporary and a rename, so it is valid at any moment of a run.
+// Datasets are referenced by the .h5 path relative to the .xdmf file's folder.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "error.hpp"
+
+namespace fsi {
+
+// Where an attribute's values live: on the grid's nodes or on its cells (rectilinear cells are
+// the rectangles between neighbouring x and y coordinates; mesh cells are triangles; polyline
+// cells are segments).
+enum class XdmfCenter { node, cell };
+
+// One field of a step: `dataset` in the .h5 file (e.g. "/step_000012/p") of float64 values.
+// Shape: scalar {ny, nx} on rectilinear nodes, {ny-1, nx-1} on its cells, {n} on mesh or polyline
+// nodes/cells. A vector has 3 components and shape {n_points, 3} (n_points = ny*nx on rectilinear
+// nodes ...): store (vx, vy, 0), because ParaView reads a 2-component "Vector" as if it had 3.
+struct XdmfAttribute {
+  std::string name;
+  XdmfCenter center = XdmfCenter::node;
+  std::string dataset;
+  std::size_t components = 1;
+};
+
+// A 2D rectilinear grid: node coordinates x (nx float64 values) and y (ny values). The caller
+// chooses what the nodes are: cell faces (then cell-centred attributes are cell averages) or
+// cell centres (then node-centred attributes are the values at the centres).
+struct XdmfRectilinear {
+  std::string x = {};
+  std::size_t nx = 0;
+  std::string y = {};
+  std::size_t ny = 0;
+};
+
+// A triangle mesh: `topology` is an int32 dataset {n_triangles, 3} of 0-based node indices,
+// written once. Node positions are an {n_nodes, 2} float64 dataset, given per step or, for a
+// mesh that does not move, once here as `geometry`.
+struct XdmfTriangles {
+  std::string topology;
+  std::size_t n_triangles = 0;
+  std::size_t n_nodes = 0;
+  std::string geometry = {};  // optional fixed geometry
+};
+
+// A set of polylines (fibers), drawn as 2-node segments so that lines of different lengths share
+// one topology: `segments` is an int32 dataset {n_segments, 2} (see polyline_segments()).
+struct XdmfPolylines {
+  std::string segments;
+  std::size_t n_segments = 0;
+  std::size_t n_nodes = 0;
+  std::string geometry = {};  // optional fixed geometry
+};
+
+// Segment connectivity for polylines stored one after the other: line k has nodes_per_line[k]
+// consecutive nodes. Returns {a0, b0, a1, b1, ...} (n_segments = sum(nodes - 1)).
+std::vector<int> polyline_segments(std::span<const std::size_t> nodes_per_line);
+
+class XdmfWriter {
+ public:
+  using Grid = std::variant<XdmfRectilinear, XdmfTriangles, XdmfPolylines>;
+
+  // `xdmf` is the side file to (re)write, `h5` the data file it points into, `name` the
+  // collection's name in ParaView. Nothing is written before the first step.
+  XdmfWriter(std::filesystem::path xdmf, const std::filesystem::path& h5, Grid grid,
+             std::string name = "grid");
+
+  // Appends one time step and rewrites the file. `geometry` is the step's {n_nodes, 2} node
+  // positions (meshes and polylines; empty = the fixed geometry; must be empty for rectilinear).
+  void add_step(double time, const std::vector<XdmfAttribute>& attributes,
+                std::string_view geometry = {});
+
+  // Restart: take back the steps of an existing side file at this path with time <= t_last
+  // (none if there is no file) and rewrite it. Call before the first add_step.
+  void resume(double t_last);
+
+  std::size_t steps() const { return m_steps.size(); }
+  const std::filesystem::path& path() const { return m_xdmf; }
+
+ private:
+  std::string data_item(std::string_view dataset, const std::vector<std::size_t>& dims,
+                        bool is_int) const;
+  void rewrite() const;
+
+  std::filesystem::path m_xdmf;
+  std::string m_h5_ref;  // the .h5 path relative to the side file's folder
+  Grid m_grid;
+  std::string m_name;
+  struct Step {
+    double time;
+    std::string xml;
+  };
+  std::vector<Step> m_steps;
+};
+
+// Checks a side file against its data: every HDF5 DataItem must name an existing dataset whose
+// shape equals its Dimensions and whose element type matches NumberType and Precision. Returns
+// the problems found, one line each (empty when consistent). Meant for tests and `validate`.
+std::vector<std::string> xdmf_check(const std::filesystem::path& xdmf);
+
+}  // namespace fsi
