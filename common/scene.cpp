@@ -209,6 +209,21 @@ void SceneTable::finish() const {
   }
 }
 
+void SceneTable::missing(std::string_view key, const char* what) const {
+  std::string hint;
+  const auto& asked = m_doc->asked[m_path];
+  for (const auto& [k, v] : as_value(m_value).as_table()) {
+    if (asked.count(k) && k != key) continue;
+    if (edit_distance(k, key) <= std::max<std::size_t>(2, key.size() / 3)) {
+      hint = fmt::format("; did you mean '{}' instead of '{}'?", key, k);
+      break;
+    }
+  }
+  const std::string name = std::string_view(what) == "table" ? "[" + key_path(key) + "]"
+                                                             : "'" + key_path(key) + "'";
+  fail_table(fmt::format("missing required {} {}{}", what, name, hint));
+}
+
 // --- typed accessors ---------------------------------------------------------------------------
 
 namespace {
@@ -220,7 +235,7 @@ double to_double(const Value& v) {
 
 double SceneTable::number(std::string_view key) const {
   const Value* v = static_cast<const Value*>(lookup(key));
-  if (!v) fail_table(fmt::format("missing required key '{}'", key_path(key)));
+  if (!v) missing(key, "key");
   if (!is_number(*v)) fail(key, fmt::format("must be a number, got {} ({})", show(*v), type_name(*v)));
   const double x = to_double(*v);
   if (!std::isfinite(x)) fail(key, fmt::format("must be finite, got {}", show(*v)));
@@ -265,7 +280,7 @@ double SceneTable::in_range(std::string_view key, double lo, double hi, bool ope
 
 long SceneTable::integer(std::string_view key) const {
   const Value* v = static_cast<const Value*>(lookup(key));
-  if (!v) fail_table(fmt::format("missing required key '{}'", key_path(key)));
+  if (!v) missing(key, "key");
   if (!v->is_integer())
     fail(key, fmt::format("must be an integer, got {} ({})", show(*v), type_name(*v)));
   return static_cast<long>(v->as_integer());
@@ -299,7 +314,7 @@ bool SceneTable::boolean(std::string_view key, bool fallback) const {
 
 std::string SceneTable::string(std::string_view key) const {
   const Value* v = static_cast<const Value*>(lookup(key));
-  if (!v) fail_table(fmt::format("missing required key '{}'", key_path(key)));
+  if (!v) missing(key, "key");
   if (!v->is_string())
     fail(key, fmt::format("must be a string, got {} ({})", show(*v), type_name(*v)));
   return v->as_string().str;
@@ -327,7 +342,7 @@ std::string SceneTable::choice(std::string_view key, const std::vector<std::stri
 
 std::vector<double> SceneTable::numbers(std::string_view key) const {
   const Value* v = static_cast<const Value*>(lookup(key));
-  if (!v) fail_table(fmt::format("missing required key '{}'", key_path(key)));
+  if (!v) missing(key, "key");
   if (!v->is_array())
     fail(key, fmt::format("must be an array of numbers, got {} ({})", show(*v), type_name(*v)));
   std::vector<double> out;
@@ -372,7 +387,7 @@ std::filesystem::path SceneTable::existing_file(std::string_view key) const {
 
 SceneTable SceneTable::table(std::string_view key) const {
   const Value* v = static_cast<const Value*>(lookup(key));
-  if (!v) fail_table(fmt::format("missing required table [{}]", key_path(key)));
+  if (!v) missing(key, "table");
   if (!v->is_table()) fail(key, fmt::format("must be a table, got {} ({})", show(*v), type_name(*v)));
   return SceneTable(m_doc, v, key_path(key));
 }

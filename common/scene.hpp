@@ -71,6 +71,7 @@ class SceneTable {
   SceneTable(std::shared_ptr<SceneDoc> doc, const void* value, std::string path);
   const void* lookup(std::string_view key) const;  // toml value or nullptr; marks key as asked
   std::string key_path(std::string_view key) const;
+  [[noreturn]] void missing(std::string_view key, const char* what) const;
   void record(std::string_view key, const std::string& toml_text) const;
 
   std::shared_ptr<SceneDoc> m_doc;

@@ -1,0 +1,116 @@
+// Protocol messages: pack/unpack round trips, and refusal of mismatched or damaged messages.
+#include <catch2/catch.hpp>
+
+#include "protocol.hpp"
+
+using namespace fsi::proto;
+
+template <class M>
+M round_trip(const M& m, std::int64_t step = 7) {
+  const auto bytes = pack_message(m, step);
+  M back;
+  if constexpr (std::is_same_v<M, Text>) back.tag = m.tag;
+  std::int64_t s = -1;
+  unpack_message(bytes, back, &s);
+  CHECK(s == step);
+  return back;
+}
+
+TEST_CASE("every message survives a round trip") {
+  GridInfo g{3, 2, 1, 0, {0, 0.5, 1, 1.5}, {0, 0.1, 0.3}, 1000.0};
+  const auto g2 = round_trip(g);
+  CHECK(g2.nx == 3);
+  CHECK(g2.periodic_x == 1);
+  CHECK(g2.y_face == g.y_face);
+  CHECK(g2.density == 1000.0);
+
+  BodyMeshes bm;
+  bm.bodies.push_back({"bar", 0, {0, 0, 1, 0, 0, 1}, {0, 1, 2}, {0, 1, 1, 2, 2, 0}});
+  bm.bodies.push_back({"cylinder", 1, {}, {}, {}});
+  const auto bm2 = round_trip(bm);
+  REQUIRE(bm2.bodies.size() == 2);
+  CHECK(bm2.bodies[0].name == "bar");
+  CHECK(bm2.bodies[0].tri == bm.bodies[0].tri);
+  CHECK(bm2.bodies[1].kind == 1);
+
+  FiberLayout fl;
+  fl.fibers.push_back({"f0", 63, 0.002, 1, "wall", 12, 0.25});
+  const auto fl2 = round_trip(fl);
+  CHECK(fl2.fibers[0].body == "wall");
+  CHECK(fl2.fibers[0].edge_s == 0.25);
+
+  Text t{Tag::final_report, "{\"a\": 1}"};
+  CHECK(round_trip(t).text == t.text);
+
+  StepBegin sb{41, 0.041, 1e-3, Action::stop};
+  const auto sb2 = round_trip(sb);
+  CHECK(sb2.step == 41);
+  CHECK(sb2.action == Action::stop);
+
+  FluidInput fi;
+  fi.solid_u = {{1, 5, 9}, {0.5, 1.0, 0.25}, {0.1, 0.2, 0.3}};
+  fi.force_v = {{4}, {-2.5}};
+  fi.sample_u = {3, 4};
+  const auto fi2 = round_trip(fi);
+  CHECK(fi2.solid_u.index == fi.solid_u.index);
+  CHECK(fi2.solid_u.velocity == fi.solid_u.velocity);
+  CHECK(fi2.solid_v.index.empty());
+  CHECK(fi2.force_v.force == fi.force_v.force);
+  CHECK(fi2.sample_u == fi.sample_u);
+
+  FluidOutput fo{{1.5, -2}, {}, {0.25}, {}, 0.3, 1e-15, 2.5};
+  const auto fo2 = round_trip(fo);
+  CHECK(fo2.fs_u == fo.fs_u);
+  CHECK(fo2.cfl == 0.3);
+
+  SolidInput si{{{1, 2, 3, 4}, {}}};
+  CHECK(round_trip(si).force == si.force);
+  SolidState ss{0.5, {{0, 0, 1, 0}}, {{0, 1, 0, 1}}};
+  const auto ss2 = round_trip(ss);
+  CHECK(ss2.x == ss.x);
+  CHECK(ss2.v == ss.v);
+  FiberInput fin{{{0.1, 0.2}}, {{0, 0, 0, 1}}};
+  CHECK(round_trip(fin).root_pose == fin.root_pose);
+  FiberState fs{1.0, {{0, 0, 0, 1}}, {{0, 0, 0, 0.9}}, {1, 2, 3}};
+  const auto fs2 = round_trip(fs);
+  CHECK(fs2.x_old == fs.x_old);
+  CHECK(fs2.root_load == fs.root_load);
+}
+
+TEST_CASE("damaged or mismatched messages are refused") {
+  StepBegin sb{1, 0.1, 0.1, Action::step};
+  auto bytes = pack_message(sb, 1);
+  SECTION("another message type") {
+    FluidInput fi;
+    CHECK_THROWS_WITH(unpack_message(bytes, fi),
+                      Catch::Contains("expected message 'fluid_input', got 'step_begin'"));
+  }
+  SECTION("another protocol version") {
+    Header h;
+    std::memcpy(&h, bytes.data(), sizeof h);
+    h.version = kVersion + 1;
+    std::memcpy(bytes.data(), &h, sizeof h);
+    StepBegin back;
+    CHECK_THROWS_WITH(unpack_message(bytes, back), Catch::Contains("message of version"));
+  }
+  SECTION("truncated") {
+    bytes.resize(bytes.size() - 3);
+    StepBegin back;
+    CHECK_THROWS_WITH(unpack_message(bytes, back), Catch::Contains("truncated"));
+  }
+  SECTION("trailing bytes") {
+    bytes.push_back(std::byte{0});
+    StepBegin back;
+    CHECK_THROWS_WITH(unpack_message(bytes, back), Catch::Contains("trailing bytes"));
+  }
+  SECTION("a vector length that does not fit") {
+    FluidInput fi;
+    fi.sample_u = {1, 2, 3};
+    auto b = pack_message(fi, 0);
+    // sample_u's length sits before its 3 ints and sample_v's (empty) length.
+    const std::int64_t huge = 1000;
+    std::memcpy(b.data() + b.size() - 8 - 12 - 8, &huge, sizeof huge);
+    FluidInput back;
+    CHECK_THROWS_WITH(unpack_message(b, back), Catch::Contains("does not fit"));
+  }
+}
