@@ -1,0 +1,198 @@
+#!/usr/bin/env bash
+# The one entry point of the project: installs what is missing, builds, runs scenes, tests,
+# validates and benchmarks. `./fsi help` lists the commands.
+set -euo pipefail
+
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+BUILD=${FSI_BUILD_DIR:-$ROOT/build}
+BIN=$BUILD/bin
+DEFAULT_SCENE=$ROOT/runs/default/scene.toml
+PACKAGES=(g++ cmake make pkg-config libeigen3-dev libopenmpi-dev openmpi-bin libhdf5-dev
+          libfftw3-dev catch2 libfmt-dev libtoml11-dev gmsh libgmsh-dev libspectra-dev
+          nlohmann-json3-dev libsuitesparse-dev python3 python3-matplotlib python3-h5py
+          python3-numpy)
+
+say() { printf '[fsi] %s\n' "$*" >&2; }
+die() { printf '[fsi] ERROR: %s\n' "$*" >&2; exit 1; }
+
+usage() {
+  cat <<'TXT'
+usage: ./fsi COMMAND [ARGS]
+
+  run [SCENE] [--overwrite]   build, then run SCENE (default: runs/default/scene.toml) as one
+                              mpirun job of the programs it needs; output in out/<scene name>/
+  test [CTEST ARGS]           build, then run the whole test suite through CTest
+  validate [CASE...]          run the validation cases in runs/ (all when none is named)
+  bench [WHAT]                run a benchmark (fluid, solid, fiber, coupled, protocol);
+                              without WHAT, list them
+  build                       install missing packages, configure and build (incremental)
+  deps                        install missing Debian packages (as root) or list them
+  mpirun SCENE                print the mpirun line for SCENE without running it
+  help                        this text
+TXT
+}
+
+# Debian packages: install what is missing when root, otherwise say exactly what to install.
+deps() {
+  local missing=()
+  for p in "${PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  if [ "$(id -u)" -eq 0 ]; then
+    say "installing Debian packages: ${missing[*]}"
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq >/dev/null
+    apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null \
+      || die "apt-get install failed for: ${missing[*]}"
+  else
+    die "missing Debian packages; install them with: sudo apt-get install ${missing[*]}"
+  fi
+}
+
+build() {
+  deps
+  if [ ! -f "$BUILD/CMakeCache.txt" ]; then
+    say "configuring in $BUILD"
+    cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release >/dev/null
+  fi
+  say "building"
+  cmake --build "$BUILD" -j "$(nproc)" 2>&1 | grep -E "error|warning|Error" >&2 || true
+  [ "${PIPESTATUS[0]}" -eq 0 ] || die "build failed (cmake --build $BUILD for the full log)"
+}
+
+mpirun_flags() {
+  local f=(--oversubscribe)
+  [ "$(id -u)" -eq 0 ] && f+=(--allow-run-as-root)
+  echo "${f[@]}"
+}
+
+# plan SCENE: sets ROLES (programs the scene needs) and NAME (its output folder name).
+plan() {
+  local out
+  out=$("$BIN/fsi-plan" "$1") || exit 1
+  ROLES=$(sed -n 's/^roles: //p' <<<"$out")
+  NAME=$(sed -n 's/^name: //p' <<<"$out")
+}
+
+# compose SCENE ARGS...: the mpirun command line, one app context per program the scene needs.
+compose() {
+  local scene=$1; shift
+  plan "$scene"
+  CMD=(mpirun $(mpirun_flags))
+  local first=1
+  for r in $ROLES; do
+    [ $first -eq 1 ] || CMD+=(:)
+    CMD+=(-n 1 "$BIN/$r" "$scene" "$@")
+    first=0
+  done
+}
+
+run() {
+  local scene=$DEFAULT_SCENE overwrite=()
+  while [ $# -gt 0 ]; do
+    case "$1" in
+      --overwrite) overwrite=(--overwrite) ;;
+      -*) die "unknown option '$1' for run (see ./fsi help)" ;;
+      *) scene=$1 ;;
+    esac
+    shift
+  done
+  [ -f "$scene" ] || die "scene file '$scene' does not exist"
+  scene=$(cd "$(dirname "$scene")" && pwd)/$(basename "$scene")
+  build
+  plan "$scene"
+  # Never overwrite silently: out/NAME, else out/NAME-2, -3, ...
+  local dir=$ROOT/out/$NAME n=2
+  if [ ${#overwrite[@]} -eq 0 ]; then
+    while [ -e "$dir" ]; do dir=$ROOT/out/$NAME-$n; n=$((n + 1)); done
+  fi
+  compose "$scene" --out-dir "$dir" "${overwrite[@]}"
+  say "running: ${CMD[*]}"
+  "${CMD[@]}"
+  # Post-processing: the scene's own plot script if its folder has one, else the generic one.
+  local plot=$(dirname "$scene")/plot
+  [ -x "$plot" ] || plot=$ROOT/runs/plot_run.py
+  FSI_ROOT=$ROOT FSI_OUT=$dir /usr/bin/python3 "$plot" "$dir" || say "post-processing failed"
+  say "output in ${dir#$ROOT/}/"
+  ls "$dir"/*.png >/dev/null 2>&1 && say "picture: $(ls "$dir"/*.png | head -1 | sed "s|$ROOT/||")"
+  return 0
+}
+
+test_suite() {
+  build
+  cd "$BUILD"
+  ctest --output-on-failure -j 2 --timeout 900 "$@"
+}
+
+validate() {
+  build
+  local cases=("$@")
+  if [ ${#cases[@]} -eq 0 ]; then
+    for d in "$ROOT"/runs/*/; do [ -x "$d/validate" ] && cases+=("$(basename "$d")"); done
+  fi
+  [ ${#cases[@]} -gt 0 ] || die "no validation cases in runs/"
+  local failed=()
+  for c in "${cases[@]}"; do
+    local script=$ROOT/runs/$c/validate
+    [ -x "$script" ] || die "no validation case '$c' (runs/$c/validate); cases: $(cd "$ROOT/runs" && ls -d */ | tr -d /)"
+    say "validating $c"
+    mkdir -p "$ROOT/out/$c"
+    if FSI_ROOT=$ROOT FSI_BIN=$BIN FSI_OUT=$ROOT/out/$c "$script"; then
+      say "$c: done (out/$c/summary.json)"
+    else
+      failed+=("$c")
+    fi
+  done
+  [ ${#failed[@]} -eq 0 ] || die "validation failed: ${failed[*]}"
+}
+
+bench() {
+  build
+  local what=${1:-}
+  local available=(protocol)
+  for b in "$BIN"/bench_*; do [ -x "$b" ] && available+=("${b##*/bench_}"); done
+  if [ -z "$what" ]; then
+    say "benchmarks: ${available[*]}"
+    return 0
+  fi
+  mkdir -p "$ROOT/out/bench"
+  if [ "$what" = protocol ]; then
+    bench_protocol
+  elif [ -x "$BIN/bench_$what" ]; then
+    "$BIN/bench_$what" --out "$ROOT/out/bench/$what.json"
+  else
+    die "no benchmark '$what'; available: ${available[*]}"
+  fi
+}
+
+# The cost of one empty protocol step: four programs, no bodies, many steps.
+bench_protocol() {
+  local scene=$ROOT/runs/bench-protocol/scene.toml dir=$ROOT/out/bench/protocol
+  local f=$(mpirun_flags)
+  mpirun $f -n 1 "$BIN/null_solver" fluid "$scene" : -n 1 "$BIN/null_solver" solid "$scene" \
+    : -n 1 "$BIN/null_solver" fiber "$scene" : -n 1 "$BIN/coupler" "$scene" \
+    --out-dir "$dir" --overwrite
+  /usr/bin/python3 - "$dir/summary.json" "$ROOT/out/bench/protocol.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+r = {"steps": s["steps"], "us_per_step": s["coupler"]["us_per_step"],
+     "note": "four programs (null solvers), no bodies: the whole per-step message sequence"}
+json.dump(r, open(sys.argv[2], "w"), indent=2)
+print(f"empty protocol step: {r['us_per_step']:.1f} us over {r['steps']} steps")
+PY
+}
+
+cmd=${1:-help}
+[ $# -gt 0 ] && shift
+case "$cmd" in
+  run) run "$@" ;;
+  test) test_suite "$@" ;;
+  validate) validate "$@" ;;
+  bench) bench "$@" ;;
+  build) build ;;
+  deps) deps ;;
+  mpirun) build >/dev/null; compose "$(realpath "${1:?scene}")"; echo "${CMD[*]}" ;;
+  help | -h | --help) usage ;;
+  *) usage; die "unknown command '$cmd'" ;;
+esac
