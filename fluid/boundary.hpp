@@ -1,0 +1,51 @@
+// Boundary conditions of the MAC grid: boundary-face values of the normal velocity (walls,
+// inflow profile with its ramp, convective outflow with global flux correction) and ghost values
+// of the tangential velocity (no-slip by quadratic extrapolation, which is exact for a parabolic
+// profile; free slip by reflection; periodic copies).
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "config.hpp"
+#include "field.hpp"
+#include "grid.hpp"
+
+namespace fluid {
+
+// Ghost value of the tangential component at one side: g = ga q0 + gb q1 + gc * data, with q0,
+// q1 the first two interior values and data the wall speed (0 for inflow).
+struct GhostRule {
+  double ga = 0, gb = 0, gc = 0;
+  bool is_data = false;  // outflow: the ghost is a value of its own (convected), not a rule
+};
+
+class Boundaries {
+ public:
+  Boundaries(const Grid& g, const std::array<SideBc, 4>& bc);
+  const SideBc& side(int s) const { return m_bc[s]; }
+  const GhostRule& rule(int s) const { return m_rule[s]; }
+  bool has_outflow() const { return m_has_outflow; }
+
+  // Inflow velocity into the domain at tangential coordinate s, time t.
+  double inflow(int side, double s, double t) const;
+  // Normal-velocity boundary faces at time t: walls 0, inflow profile. Outflow faces: convected
+  // from their current values over dt, then all outflow faces are shifted by one constant so
+  // that the net flux through the boundary is zero. Tangential outflow ghosts are convected too.
+  void advance_normal(Field& u, Field& v, double t, double dt);
+  // Tangential ghosts (rules), periodic copies; the wall data at time t.
+  void fill_ghosts(Field& u, Field& v, double t) const;
+  // Periodic copies and zero-gradient ghosts of a cell-centred field (pressure).
+  void fill_scalar(Field& p) const;
+  // Net volume flux into the domain through its boundary (per unit depth).
+  double net_inflow(const Field& u, const Field& v) const;
+
+ private:
+  const Grid& m_g;
+  std::array<SideBc, 4> m_bc;
+  std::array<GhostRule, 4> m_rule;
+  bool m_has_outflow = false;
+  std::array<std::vector<double>, 4> m_prev;  // Orlanski: last step's first interior line
+};
+
+}  // namespace fluid

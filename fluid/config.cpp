@@ -1,0 +1,259 @@
+// Reading and checking the [fluid] table of a scene.
+#include "config.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "error.hpp"
+#include "scene.hpp"
+
+namespace fluid {
+namespace {
+
+const char* type_name(BcType t) {
+  switch (t) {
+    case BcType::periodic: return "periodic";
+    case BcType::wall: return "wall";
+    case BcType::slip: return "slip";
+    case BcType::inflow: return "inflow";
+    case BcType::outflow: return "outflow";
+  }
+  return "?";
+}
+
+[[noreturn]] void bad(const Config& c, const std::string& msg) {
+  throw fsi::InputError(c.source.empty() ? msg : fmt::format("{} (in {})", msg, c.source));
+}
+
+double min_width(const AxisSpec& a) {
+  // tanh clustering: the first cell is the smallest.
+  if (a.tanh_beta > 0) {
+    const double x1 = 0.5 * a.length *
+                      (1.0 + std::tanh(a.tanh_beta * (2.0 / a.cells - 1)) / std::tanh(a.tanh_beta));
+    return x1;
+  }
+  return a.length / a.cells;
+}
+
+}  // namespace
+
+double explicit_diffusion_limit(const Config& c) {
+  const double nu = c.viscosity / c.density;
+  const double hx = min_width(c.x), hy = min_width(c.y);
+  return 1.0 / (4.0 * nu * (1.0 / (hx * hx) + 1.0 / (hy * hy)));
+}
+
+void validate(const Config& c, double dt) {
+  if (!(c.density > 0)) bad(c, fmt::format("fluid.density must be > 0, got {}", c.density));
+  if (!(c.viscosity > 0)) bad(c, fmt::format("fluid.viscosity must be > 0, got {}", c.viscosity));
+  constexpr int kMinCells = 4;
+  if (c.x.cells < kMinCells || c.y.cells < kMinCells) {
+    bad(c, fmt::format("fluid.grid.cells must be >= {} in each direction for the stencil, got [{}, {}]",
+                       kMinCells, c.x.cells, c.y.cells));
+  }
+  if (!(c.x.length > 0) || !(c.y.length > 0)) {
+    bad(c, fmt::format("fluid.grid.size must be > 0 in each direction, got [{}, {}]", c.x.length,
+                       c.y.length));
+  }
+  for (int a = 0; a < 2; ++a) {
+    const SideBc& lo = c.bc[2 * a];
+    const SideBc& hi = c.bc[2 * a + 1];
+    const bool plo = lo.type == BcType::periodic, phi = hi.type == BcType::periodic;
+    if (plo != phi) {
+      const int per = plo ? 2 * a : 2 * a + 1, other = plo ? 2 * a + 1 : 2 * a;
+      if (c.bc[other].type == BcType::inflow) {
+        bad(c, fmt::format("fluid.boundary.{}: an inflow cannot face a periodic side "
+                           "(fluid.boundary.{} is periodic); make both sides periodic or neither",
+                           kSideNames[other], kSideNames[per]));
+      }
+      bad(c, fmt::format("fluid.boundary.{} is periodic but fluid.boundary.{} is {}: periodic must "
+                         "be set on both sides of a direction",
+                         kSideNames[per], kSideNames[other], type_name(c.bc[other].type)));
+    }
+  }
+  for (int s = 0; s < 4; ++s) {
+    const SideBc& b = c.bc[s];
+    if (b.type == BcType::inflow && b.ramp != Ramp::none && !(b.ramp_time > 0)) {
+      bad(c, fmt::format("fluid.boundary.{}.ramp_time must be > 0 with a ramp, got {}", kSideNames[s],
+                         b.ramp_time));
+    }
+  }
+  const bool px = c.bc[left].type == BcType::periodic, py = c.bc[bottom].type == BcType::periodic;
+  const bool x_stretched = c.x.sponge_cells > 0 && c.x.sponge_ratio != 1.0;
+  const bool y_stretched = c.y.tanh_beta > 0;
+  if (c.x.sponge_cells > 0 && c.bc[right].type != BcType::outflow) {
+    bad(c, fmt::format("fluid.sponge needs an outflow on the right side, got fluid.boundary.right = {}",
+                       type_name(c.bc[right].type)));
+  }
+  if (y_stretched && py) {
+    bad(c, fmt::format("fluid.grid.y_stretch = {} stretches a periodic direction; the fast Poisson "
+                       "solver transforms periodic directions, which must be uniform",
+                       c.y.tanh_beta));
+  }
+  if (x_stretched && y_stretched) {
+    bad(c, fmt::format("fluid.grid.y_stretch = {} with a stretched outlet sponge in x: the fast "
+                       "Poisson solver needs one uniform direction to transform",
+                       c.y.tanh_beta));
+  }
+  if (x_stretched && px) bad(c, "fluid.sponge: the sponge stretches x, which is periodic");
+  if (!(dt > 0)) bad(c, fmt::format("time.dt must be > 0, got {}", dt));
+  const double nu = c.viscosity / c.density;
+  if (!c.implicit) {
+    const double lim = explicit_diffusion_limit(c);
+    if (dt > lim) {
+      bad(c, fmt::format("time.dt = {:g} is above the explicit diffusion stability limit {:.6g} "
+                         "(1 / (4 nu (1/dx^2 + 1/dy^2)), nu = {:g}); lower dt or set "
+                         "fluid.diffusion = \"implicit\"",
+                         dt, lim, nu));
+    }
+  } else {
+    // Crank-Nicolson with a wall or outflow across the transform direction (see predictor_implicit).
+    const int t = x_stretched ? 1 : 0;
+    const bool closure_mismatch = !(t == 0 ? px : py);
+    const double h = t == 0 ? c.x.length / c.x.cells : c.y.length / c.y.cells;
+    if (closure_mismatch && nu * dt / (h * h) >= 2.0) {
+      bad(c, fmt::format("time.dt = {:g} is above the limit {:.6g} of implicit diffusion with walls "
+                         "across the {} direction (nu dt / h^2 < 2); lower dt",
+                         dt, 2.0 * h * h / nu, t == 0 ? "x" : "y"));
+    }
+  }
+  // Start-up CFL from the initial field and the inflow speeds.
+  double umax = std::hypot(c.initial.velocity[0], c.initial.velocity[1]);
+  if (c.initial.type == InitialType::taylor_green || c.initial.type == InitialType::vortex) {
+    umax += std::abs(c.initial.amplitude) * std::max(1.0, c.x.length / c.y.length);
+  }
+  for (int s = 0; s < 4; ++s) {
+    const SideBc& b = c.bc[s];
+    if (b.type == BcType::inflow) umax = std::max(umax, std::abs(b.mean) * (b.profile == Profile::parabolic ? 1.5 : 1.0));
+    if (b.type == BcType::wall) umax = std::max(umax, std::abs(b.velocity));
+  }
+  const double hmin = std::min(min_width(c.x), min_width(c.y));
+  const double cfl = umax * dt / hmin;
+  if (cfl > c.cfl_max) {
+    bad(c, fmt::format("time.dt = {:g} gives a start-up CFL number {:.4g} above the limit "
+                       "fluid.health.cfl_max = {:g} (speed {:g}, smallest cell {:g}); the largest "
+                       "stable dt is {:.6g}",
+                       dt, cfl, c.cfl_max, umax, hmin, c.cfl_max * hmin / umax));
+  }
+}
+
+namespace {
+
+SideBc read_side(const fsi::SceneTable& t) {
+  SideBc b;
+  const std::string type = t.choice("type", {"periodic", "wall", "slip", "inflow", "outflow"});
+  if (type == "periodic") b.type = BcType::periodic;
+  if (type == "wall") {
+    b.type = BcType::wall;
+    b.velocity = t.number("velocity", 0.0);
+  }
+  if (type == "slip") b.type = BcType::slip;
+  if (type == "inflow") {
+    b.type = BcType::inflow;
+    b.profile = t.choice("profile", {"parabolic", "uniform"}, "parabolic") == "uniform"
+                    ? Profile::uniform
+                    : Profile::parabolic;
+    b.mean = t.number("mean");
+    const std::string ramp = t.choice("ramp", {"none", "cosine", "linear"}, "none");
+    b.ramp = ramp == "cosine" ? Ramp::cosine : ramp == "linear" ? Ramp::linear : Ramp::none;
+    b.ramp_time = b.ramp == Ramp::none ? 0.0 : t.positive("ramp_time");
+  }
+  if (type == "outflow") {
+    b.type = BcType::outflow;
+    b.phase = t.choice("phase", {"bulk", "orlanski"}, "bulk") == "orlanski" ? Phase::orlanski : Phase::bulk;
+  }
+  t.finish();
+  return b;
+}
+
+}  // namespace
+
+Config read_config(const fsi::SceneTable& f, double dt) {
+  Config c;
+  c.source = f.file().string();
+  c.density = f.positive("density");
+  c.viscosity = f.positive("viscosity");
+  c.implicit = f.choice("diffusion", {"explicit", "implicit"}, "explicit") == "implicit";
+
+  const fsi::SceneTable g = f.table("grid");
+  const std::vector<double> cells = g.numbers("cells");
+  if (cells.size() != 2) g.fail("cells", fmt::format("must be [nx, ny], got {} numbers", cells.size()));
+  for (double n : cells) {
+    if (n != std::floor(n)) g.fail("cells", fmt::format("must be integers, got {}", n));
+    if (n < 4) g.fail("cells", fmt::format("must be >= 4 in each direction for the stencil, got {}", n));
+  }
+  const auto size = g.vec2("size");
+  if (!(size[0] > 0 && size[1] > 0)) g.fail("size", fmt::format("must be > 0, got [{}, {}]", size[0], size[1]));
+  const auto origin = g.vec2("origin", {0.0, 0.0});
+  c.x = {int(cells[0]), size[0], origin[0]};
+  c.y = {int(cells[1]), size[1], origin[1]};
+  c.y.tanh_beta = g.non_negative("y_stretch", 0.0);
+  g.finish();
+
+  const fsi::SceneTable b = f.table("boundary");
+  for (int s = 0; s < 4; ++s) c.bc[s] = read_side(b.table(kSideNames[s]));
+  b.finish();
+  c.x.periodic = c.bc[left].type == BcType::periodic;
+  c.y.periodic = c.bc[bottom].type == BcType::periodic;
+
+  if (auto sp = f.optional_table("sponge")) {
+    c.x.sponge_cells = int(sp->positive_integer("cells"));
+    c.x.sponge_ratio = sp->in_range("ratio", 1.0, 1.5, false, 1.05);
+    sp->finish();
+  }
+  if (auto fo = f.optional_table("forcing")) {
+    c.body = fo->vec2("body", {0.0, 0.0});
+    c.oscillating = fo->vec2("oscillating", {0.0, 0.0});
+    c.gravity = fo->vec2("gravity", {0.0, 0.0});
+    const bool osc = c.oscillating[0] != 0 || c.oscillating[1] != 0;
+    c.period = osc ? fo->positive("period") : fo->positive("period", 1.0);
+    c.phase = fo->number("phase", 0.0);
+    fo->finish();
+  }
+  if (auto in = f.optional_table("initial")) {
+    const std::string t = in->choice("type", {"rest", "uniform", "taylor-green", "vortex"}, "rest");
+    c.initial.type = t == "uniform"        ? InitialType::uniform
+                     : t == "taylor-green" ? InitialType::taylor_green
+                     : t == "vortex"       ? InitialType::vortex
+                                           : InitialType::rest;
+    if (t == "uniform" || t == "vortex") c.initial.velocity = in->vec2("velocity", {0.0, 0.0});
+    if (t == "taylor-green" || t == "vortex") c.initial.amplitude = in->number("amplitude");
+    if (t == "vortex") {
+      c.initial.centre = in->vec2("centre");
+      c.initial.radius = in->positive("radius");
+    }
+    in->finish();
+  }
+  for (const fsi::SceneTable& p : f.tables("probes")) {
+    c.probes.push_back({p.string("name"), p.vec2("at")});
+    p.finish();
+  }
+  if (auto d = f.optional_table("diagnostics")) {
+    const std::string ws = d->choice("wall_shear", {"none", "left", "right", "bottom", "top", "both_y", "both_x"}, "none");
+    if (ws == "both_y") c.wall_shear = {bottom, top};
+    else if (ws == "both_x") c.wall_shear = {left, right};
+    else if (ws != "none") {
+      for (int s = 0; s < 4; ++s)
+        if (ws == kSideNames[s]) c.wall_shear = {Side(s)};
+    }
+    d->finish();
+  }
+  if (auto h = f.optional_table("health")) {
+    c.cfl_max = h->positive("cfl_max", 1.0);
+    c.divergence_max = h->positive("divergence_max", 1e-6);
+    c.health_every = h->positive_integer("every", 10);
+    h->finish();
+  }
+  for (Side s : c.wall_shear) {
+    if (c.bc[s].type != BcType::wall) {
+      f.fail("diagnostics", fmt::format("wall_shear on side {} which is not a wall", kSideNames[s]));
+    }
+  }
+  f.finish();
+  validate(c, dt);
+  return c;
+}
+
+}  // namespace fluid

@@ -1,0 +1,80 @@
+// Settings of the fluid solver, read from the scene's [fluid] table (read_config) or filled in
+// directly by tests and drivers. fluid/README.md documents every key with an example scene.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "grid.hpp"
+
+namespace fsi {
+class SceneTable;
+}
+
+namespace fluid {
+
+enum Side : int { left = 0, right = 1, bottom = 2, top = 3 };
+inline constexpr const char* kSideNames[4] = {"left", "right", "bottom", "top"};
+
+enum class BcType { periodic, wall, slip, inflow, outflow };
+enum class Profile { uniform, parabolic };
+enum class Ramp { none, cosine, linear };
+enum class Phase { bulk, orlanski };
+
+struct SideBc {
+  BcType type = BcType::wall;
+  double velocity = 0;  // wall: tangential speed along +x (bottom/top) or +y (left/right)
+  Profile profile = Profile::parabolic;  // inflow: profile shape ...
+  double mean = 0;                       // ... mean speed into the domain ...
+  Ramp ramp = Ramp::none;                // ... and its start-up in time:
+  double ramp_time = 0;  // cosine: (1 - cos(pi t / T)) / 2 for t < T (Turek-Hron Eq. 26)
+  Phase phase = Phase::bulk;  // outflow: convection speed, the bulk outlet velocity or Orlanski's
+};
+
+enum class InitialType { rest, uniform, taylor_green, vortex };
+struct Initial {
+  InitialType type = InitialType::rest;
+  std::array<double, 2> velocity{0, 0};  // uniform part (uniform, vortex)
+  double amplitude = 1;                  // taylor_green: U0; vortex: peak swirl speed
+  std::array<double, 2> centre{0, 0};    // vortex centre
+  double radius = 0.1;                   // vortex core radius (Gaussian, Lamb-Oseen like)
+};
+
+struct Probe {
+  std::string name;
+  std::array<double, 2> at{0, 0};
+};
+
+struct Config {
+  double density = 1;    // rho_f > 0
+  double viscosity = 0;  // dynamic, mu_f > 0
+  AxisSpec x, y;
+  std::array<SideBc, 4> bc;  // left, right, bottom, top
+  bool implicit = false;     // Crank-Nicolson diffusion (else explicit AB2)
+  // Body force per unit volume f(t) = body + oscillating sin(2 pi t / period + phase) (Eq. 29
+  // with body = 0), plus rho g.
+  std::array<double, 2> body{0, 0}, oscillating{0, 0}, gravity{0, 0};
+  double period = 0, phase = 0;
+  Initial initial;
+  std::vector<Probe> probes;
+  std::vector<Side> wall_shear;  // sides along which tau_w (Eq. 30) is written
+  double cfl_max = 1.0;          // health: stop above this CFL number
+  double divergence_max = 1e-6;  // health: stop when max |div u| dt exceeds this (after growth)
+  long health_every = 10;        // steps between divergence checks
+  std::string source;            // scene file, for error messages
+};
+
+// Read [fluid] strictly (unknown keys are errors). dt is the scene's time step: the explicit
+// stability limits are checked against it.
+Config read_config(const fsi::SceneTable& fluid, double dt);
+
+// Structural checks shared by read_config and the Solver (throws fsi::InputError naming the
+// key): grid too small, periodic on one side only, inflow on a periodic side, stretched
+// transform direction, dt above the explicit diffusion limit.
+void validate(const Config& c, double dt);
+
+// Largest dt of explicit AB2 diffusion: 1 / (4 nu (1/dx_min^2 + 1/dy_min^2)).
+double explicit_diffusion_limit(const Config& c);
+
+}  // namespace fluid

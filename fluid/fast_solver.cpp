@@ -1,0 +1,166 @@
+// FFTW transforms + Thomas sweeps: the exact direct solver of the discrete Poisson and
+// Helmholtz problems on the MAC grid.
+#include "fast_solver.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace fluid {
+namespace {
+
+struct Kinds {
+  fftw_r2r_kind fwd, bwd;
+  double norm;  // backward(forward(x)) = norm * x
+};
+
+Kinds kinds_for(int n, Closure lo, Closure hi) {
+  using C = Closure;
+  if (lo == C::periodic && hi == C::periodic) return {FFTW_R2HC, FFTW_HC2R, double(n)};
+  if (lo == C::dirichlet_node && hi == C::dirichlet_node) return {FFTW_RODFT00, FFTW_RODFT00, 2.0 * (n + 1)};
+  if (lo == C::neumann_half && hi == C::neumann_half) return {FFTW_REDFT10, FFTW_REDFT01, 2.0 * n};
+  if (lo == C::dirichlet_half && hi == C::dirichlet_half) return {FFTW_RODFT10, FFTW_RODFT01, 2.0 * n};
+  if (lo == C::dirichlet_half && hi == C::neumann_half) return {FFTW_RODFT11, FFTW_RODFT11, 2.0 * n};
+  if (lo == C::neumann_half && hi == C::dirichlet_half) return {FFTW_REDFT11, FFTW_REDFT11, 2.0 * n};
+  throw std::invalid_argument("fluid::FastSolver: no real transform for this pair of closures");
+}
+
+}  // namespace
+
+// lambda_k = -(4 / h^2) sin^2(theta_k / 2), theta_k the angle of mode k:
+//   periodic 2 pi k / n, dirichlet_node pi (k+1) / (n+1), neumann_half pi k / n,
+//   dirichlet_half pi (k+1) / n, mixed half closures pi (k + 1/2) / n.
+std::vector<double> eigenvalues(int n, double h, Closure lo, Closure hi) {
+  using C = Closure;
+  const double pi = std::numbers::pi;
+  std::vector<double> lam(n);
+  for (int k = 0; k < n; ++k) {
+    double theta;
+    if (lo == C::periodic) {
+      const int m = k <= n / 2 ? k : n - k;  // halfcomplex: index n-k holds mode k's sine part
+      theta = 2 * pi * m / n;
+    } else if (lo == C::dirichlet_node) {
+      theta = pi * (k + 1) / (n + 1);
+    } else if (lo == C::neumann_half && hi == C::neumann_half) {
+      theta = pi * k / n;
+    } else if (lo == C::dirichlet_half && hi == C::dirichlet_half) {
+      theta = pi * (k + 1) / n;
+    } else {
+      theta = pi * (k + 0.5) / n;
+    }
+    const double s = std::sin(0.5 * theta);
+    lam[k] = -4.0 * s * s / (h * h);
+  }
+  return lam;
+}
+
+FastSolver::FastSolver(const Operator1D& t, const Operator1D& s, double sigma)
+    : m_nt(t.n), m_ns(s.n), m_transform_s(s.lo == Closure::periodic) {
+  const std::size_t size = std::size_t(m_nt) * m_ns;
+  m_buf = fftw_alloc_real(size);
+  for (std::size_t q = 0; q < size; ++q) m_buf[q] = 0;
+  const Kinds kt = kinds_for(m_nt, t.lo, t.hi);
+  const std::vector<double> lt = eigenvalues(m_nt, t.h, t.lo, t.hi);
+  // FFTW_ESTIMATE: the plan does not depend on timings, so two runs are bit-identical.
+  if (m_transform_s) {
+    const Kinds ks = kinds_for(m_ns, s.lo, s.hi);
+    m_fwd = fftw_plan_r2r_2d(m_ns, m_nt, m_buf, m_buf, ks.fwd, kt.fwd, FFTW_ESTIMATE);
+    m_bwd = fftw_plan_r2r_2d(m_ns, m_nt, m_buf, m_buf, ks.bwd, kt.bwd, FFTW_ESTIMATE);
+    m_norm = kt.norm * ks.norm;
+    const std::vector<double> ls = eigenvalues(m_ns, s.h, s.lo, s.hi);
+    m_inv_eig.assign(size, 0);
+    for (int j = 0; j < m_ns; ++j) {
+      for (int k = 0; k < m_nt; ++k) {
+        const double e = lt[k] + ls[j] - sigma;
+        // The constant mode of a singular problem: its coefficient is set to zero (zero mean).
+        m_inv_eig[k + std::size_t(m_nt) * j] = (e == 0.0) ? 0.0 : 1.0 / (e * m_norm);
+      }
+    }
+  } else {
+    const int n[1] = {m_nt};
+    fftw_r2r_kind kf[1] = {kt.fwd}, kb[1] = {kt.bwd};
+    m_fwd = fftw_plan_many_r2r(1, n, m_ns, m_buf, nullptr, 1, m_nt, m_buf, nullptr, 1, m_nt, kf,
+                               FFTW_ESTIMATE);
+    m_bwd = fftw_plan_many_r2r(1, n, m_ns, m_buf, nullptr, 1, m_nt, m_buf, nullptr, 1, m_nt, kb,
+                               FFTW_ESTIMATE);
+    m_norm = kt.norm;
+    // Thomas factors of (a, b + lambda_k - sigma, c) for every wavenumber k; the
+    // normalisation of the transform pair is folded into the first pivot's right-hand side.
+    m_a = s.a;
+    m_inv_piv.assign(size, 0);
+    m_gamma.assign(size, 0);
+    for (int k = 0; k < m_nt; ++k) {
+      const bool zero = sigma == 0.0 && lt[k] == 0.0 && s.singular;
+      if (zero) m_zero_mode = k;
+      double gprev = 0;
+      for (int j = 0; j < m_ns; ++j) {
+        const double piv = s.b[j] + lt[k] - sigma - s.a[j] * gprev;
+        const std::size_t q = k + std::size_t(m_nt) * j;
+        const bool last = j == m_ns - 1;
+        // A singular problem's last pivot is zero: fixing that unknown to 0 picks one solution.
+        m_inv_piv[q] = (zero && last) ? 0.0 : 1.0 / piv;
+        m_gamma[q] = last ? 0.0 : s.c[j] / piv;
+        gprev = m_gamma[q];
+      }
+    }
+  }
+  if (!m_fwd || !m_bwd) throw std::runtime_error("fluid::FastSolver: FFTW could not plan");
+}
+
+FastSolver::~FastSolver() {
+  if (m_fwd) fftw_destroy_plan(m_fwd);
+  if (m_bwd) fftw_destroy_plan(m_bwd);
+  fftw_free(m_buf);
+}
+
+void FastSolver::forward() { fftw_execute(m_fwd); }
+void FastSolver::backward() { fftw_execute(m_bwd); }
+
+// Per wavenumber k: a_j y_{j-1} + (b_j + lambda_k - sigma) y_j + c_j y_{j+1} = rhat_j / norm,
+// forward elimination then back substitution, vectorised across k (k is contiguous).
+void FastSolver::tridiagonal() {
+  const int nt = m_nt, ns = m_ns;
+  double* x = m_buf;
+  if (m_transform_s) {
+    const std::size_t size = std::size_t(nt) * ns;
+    const double* e = m_inv_eig.data();
+    for (std::size_t q = 0; q < size; ++q) x[q] *= e[q];
+    return;
+  }
+  const double inv_norm = 1.0 / m_norm;
+  {
+    const double* ip = m_inv_piv.data();
+    for (int k = 0; k < nt; ++k) x[k] *= inv_norm * ip[k];
+  }
+  for (int j = 1; j < ns; ++j) {
+    double* xj = x + std::size_t(nt) * j;
+    const double* xm = xj - nt;
+    const double* ip = m_inv_piv.data() + std::size_t(nt) * j;
+    const double aj = m_a[j];
+    for (int k = 0; k < nt; ++k) xj[k] = (xj[k] * inv_norm - aj * xm[k]) * ip[k];
+  }
+  for (int j = ns - 2; j >= 0; --j) {
+    double* xj = x + std::size_t(nt) * j;
+    const double* xp = xj + nt;
+    const double* g = m_gamma.data() + std::size_t(nt) * j;
+    for (int k = 0; k < nt; ++k) xj[k] -= g[k] * xp[k];
+  }
+  // Remove the weighted mean of the singular mode's line (the t-mean of the solution).
+  if (m_zero_mode >= 0 && !m_weights.empty()) {
+    double sw = 0, s = 0;
+    for (int j = 0; j < ns; ++j) {
+      sw += m_weights[j];
+      s += m_weights[j] * x[m_zero_mode + std::size_t(nt) * j];
+    }
+    const double mean = s / sw;
+    for (int j = 0; j < ns; ++j) x[m_zero_mode + std::size_t(nt) * j] -= mean;
+  }
+}
+
+void FastSolver::solve() {
+  forward();
+  tridiagonal();
+  backward();
+}
+
+}  // namespace fluid

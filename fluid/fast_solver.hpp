@@ -1,0 +1,71 @@
+// Direct fast solver for (L_t + L_s - sigma) x = r on a 2D array of unknowns, where L_t and L_s
+// are the 1D second-difference operators along the two grid directions. The transform
+// direction t must be uniform: FFTW's real transforms (DFT for periodic, DCT/DST for the other
+// closures) diagonalise L_t exactly, so the solve is exact to round-off. The other direction s
+// may be stretched: it is solved by a tridiagonal (Thomas) sweep per wavenumber, or transformed
+// too when it is periodic. Used for the pressure Poisson equation (sigma = 0) and for the
+// Crank-Nicolson Helmholtz equations of the velocity components (sigma = 2 / (nu dt)).
+#pragma once
+
+#include <fftw3.h>
+
+#include <vector>
+
+namespace fluid {
+
+// How a 1D operator ends, seen from its unknowns.
+//   dirichlet_node: the boundary value sits one spacing beyond the last unknown (zero there)
+//   dirichlet_half / neumann_half: zero value / zero gradient half a spacing beyond it
+enum class Closure { periodic, dirichlet_node, dirichlet_half, neumann_half };
+
+// A 1D operator along one direction: n unknowns. In a transform direction only n, h and the
+// closures matter. In a tridiagonal direction row k reads a[k] x[k-1] + b[k] x[k] + c[k] x[k+1]
+// (a[0] = c[n-1] = 0), whatever the grid and the boundary rows; `singular` says the operator
+// annihilates constants (pure Neumann), so that the sigma = 0 problem is solved up to a constant.
+struct Operator1D {
+  int n = 0;
+  Closure lo = Closure::neumann_half, hi = Closure::neumann_half;
+  double h = 0;                   // spacing (transform direction)
+  std::vector<double> a, b, c;    // tridiagonal rows (tridiagonal direction)
+  bool singular = false;
+};
+
+// Eigenvalues of the uniform 1D operator with the given closures, in the order of the FFTW
+// transform that diagonalises it (halfcomplex order for periodic).
+std::vector<double> eigenvalues(int n, double h, Closure lo, Closure hi);
+
+class FastSolver {
+ public:
+  // t: the transform direction's operator (uniform); s: the other one. When s.lo is periodic,
+  // s is transformed too. The unknowns are stored t-fastest: x[k + nt * j].
+  FastSolver(const Operator1D& t, const Operator1D& s, double sigma);
+  ~FastSolver();
+  FastSolver(const FastSolver&) = delete;
+  FastSolver& operator=(const FastSolver&) = delete;
+
+  int nt() const { return m_nt; }
+  int ns() const { return m_ns; }
+  double* data() { return m_buf; }  // right-hand side in, solution out
+  // Solve in place on data(). For sigma = 0 with a singular operator, the solution has zero
+  // mean weighted by `weights` (per s-row; the t-direction is uniform) when given.
+  void solve();
+  // The three phases, for the benchmark of a bare solve.
+  void forward();
+  void tridiagonal();
+  void backward();
+  void set_mean_weights(const std::vector<double>& w) { m_weights = w; }
+
+ private:
+  int m_nt, m_ns;
+  bool m_transform_s;
+  double* m_buf = nullptr;
+  fftw_plan m_fwd = nullptr, m_bwd = nullptr;
+  double m_norm = 1;
+  std::vector<double> m_a;                // sub-diagonal per s-row
+  std::vector<double> m_inv_piv, m_gamma;  // Thomas factors per (k, j), k fastest
+  std::vector<double> m_inv_eig;           // 2D transform: 1 / eigenvalue per (k, j)
+  std::vector<double> m_weights;
+  int m_zero_mode = -1;                    // index k of the t-mode whose s-problem is singular
+};
+
+}  // namespace fluid

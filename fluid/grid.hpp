@@ -1,0 +1,70 @@
+// The fluid's fixed Cartesian grid: cell faces and centres along x and y, each direction uniform,
+// tanh-clustered towards both ends (y), or uniform with a geometrically stretched outlet sponge
+// appended at x = x_max. Holds the precomputed inverse spacings and interpolation weights that the
+// staggered (MAC) stencils use, ghost cells included.
+#pragma once
+
+#include <vector>
+
+namespace fluid {
+
+// How one direction is laid out.
+struct AxisSpec {
+  int cells = 0;             // cells in [origin, origin + length]
+  double length = 0;
+  double origin = 0;
+  bool periodic = false;
+  double tanh_beta = 0;      // > 0: faces clustered towards both ends, x = L/2 (1 + tanh(b s)/tanh(b))
+  int sponge_cells = 0;      // extra cells appended beyond origin + length ...
+  double sponge_ratio = 1;   // ... each this much wider than the previous one
+};
+
+// One direction. Index conventions: cells 0..n-1, faces 0..n (face i is the low side of cell i).
+// Stencil arrays also cover one ghost cell on each side: widths w(i) for i in [-1, n], ghost
+// cells mirror the first/last cell (or wrap around when periodic).
+class Axis {
+ public:
+  explicit Axis(const AxisSpec& spec);
+  int n() const { return m_n; }
+  bool periodic() const { return m_periodic; }
+  bool uniform() const { return m_uniform; }
+  double h() const { return m_w[1]; }  // width of cell 0 (the spacing when uniform)
+  double face(int i) const { return m_face[i + 1]; }      // i in [-1, n+1]
+  double centre(int i) const { return m_centre[i + 1]; }  // i in [-1, n]
+  double lo() const { return face(0); }
+  double hi() const { return face(m_n); }
+  double length() const { return hi() - lo(); }
+  double width(int i) const { return m_w[i + 1]; }         // i in [-1, n]
+  // Arrays with offset 1 (index i + 1) for the hot loops:
+  const double* wi() const { return m_wi.data() + 1; }   // 1 / width(i), i in [-1, n]
+  const double* di() const { return m_di.data() + 1; }   // 1 / (centre(i) - centre(i-1)), i in [-1, n+1]
+  const double* ci() const { return m_ci.data() + 1; }   // 2 / (centre(i+1) - centre(i-1)), i in [-1, n]
+  // Interpolation from centres i-1, i to face i: weight of centre i-1 (lo) and i (hi).
+  const double* wlo() const { return m_wlo.data() + 1; }  // i in [-1, n+1]
+  const double* whi() const { return m_whi.data() + 1; }
+  int sponge_start() const { return m_sponge_start; }     // first sponge cell (n when none)
+
+ private:
+  int m_n;
+  bool m_periodic, m_uniform;
+  int m_sponge_start;
+  std::vector<double> m_face, m_centre, m_w, m_wi, m_di, m_ci, m_wlo, m_whi;
+};
+
+class Grid {
+ public:
+  Grid(const AxisSpec& x, const AxisSpec& y) : m_x(x), m_y(y) {}
+  const Axis& x() const { return m_x; }
+  const Axis& y() const { return m_y; }
+  const Axis& axis(int a) const { return a == 0 ? m_x : m_y; }
+  int nx() const { return m_x.n(); }
+  int ny() const { return m_y.n(); }
+  // Face counts of the coupling index (periodic directions have no duplicate last face).
+  int nu() const { return m_x.periodic() ? nx() : nx() + 1; }
+  int nv() const { return m_y.periodic() ? ny() : ny() + 1; }
+
+ private:
+  Axis m_x, m_y;
+};
+
+}  // namespace fluid

@@ -1,0 +1,136 @@
+// Convection and diffusion kernels: plain loops, j outer, i inner, on precomputed inverse
+// spacings.
+#include "momentum.hpp"
+
+namespace fluid {
+
+SpongeWeights sponge_weights(const Grid& g) {
+  SpongeWeights s;
+  const int nx = g.nx(), start = g.x().sponge_start();
+  s.active = start < nx;
+  s.centre.assign(nx + 2, 0);
+  s.face.assign(nx + 3, 0);
+  for (int i = -1; i <= nx; ++i) s.centre[i + 1] = i >= start ? 1.0 : 0.0;
+  for (int i = -1; i <= nx + 1; ++i) s.face[i + 1] = i >= start ? 1.0 : 0.0;
+  return s;
+}
+
+namespace {
+
+// Flux value carried by velocity `a` across a face between values lo and hi: the average, or,
+// with weight b, the upwind value.
+template <bool Upwind>
+inline double carried(double a, double lo, double hi, double b) {
+  const double c = 0.5 * (lo + hi);
+  if constexpr (Upwind) {
+    const double up = a > 0 ? lo : hi;
+    return c + b * (up - c);
+  } else {
+    (void)a;
+    (void)b;
+    return c;
+  }
+}
+
+// u face (i, j) at (x_face_i, y_centre_j):
+//   d(uu)/dx = (U_{i+1/2} q_{i+1/2} - U_{i-1/2} q_{i-1/2}) / (xc_i - xc_{i-1}),  U = (u_i + u_{i+1})/2
+//   d(vu)/dy = (V_{j+1/2} q_{j+1/2} - V_{j-1/2} q_{j-1/2}) / (yf_{j+1} - yf_j),  V, q at the corners
+//   lap(u)   = [(u_{i+1}-u_i)/w_i - (u_i-u_{i-1})/w_{i-1}] / d_i
+//            + [(u_{j+1}-u_j)/d_{j+1} - (u_j-u_{j-1})/d_j] * 2 / (yc_{j+1} - yc_{j-1})
+// with q the carried value (central average or upwind), corner interpolation weighted by distance.
+// v face (i, j) at (x_centre_i, y_face_j) likewise with the roles of x and y exchanged.
+template <bool Upwind, bool Lap>
+void kernel(const Grid& g, const SpongeWeights& sw, const Field& u, const Field& v, double nu_e,
+            int i0, int j0, Field& hu, Field& hv, Field* lu, Field* lv) {
+  const int nx = g.nx(), ny = g.ny();
+  const Axis& X = g.x();
+  const Axis& Y = g.y();
+  const double *xwi = X.wi(), *xdi = X.di(), *xci = X.ci(), *xlo = X.wlo(), *xhi = X.whi();
+  const double *ywi = Y.wi(), *ydi = Y.di(), *yci = Y.ci(), *ylo = Y.wlo(), *yhi = Y.whi();
+  const double* bc = Upwind ? sw.centre.data() + 1 : nullptr;
+  const double* bf = Upwind ? sw.face.data() + 1 : nullptr;
+
+  for (int j = 0; j < ny; ++j) {
+    const double* uc = u.row(j);
+    const double* un = u.row(j + 1);
+    const double* us = u.row(j - 1);
+    const double* vc = v.row(j);
+    const double* vn = v.row(j + 1);
+    double* h = hu.row(j);
+    double* l = Lap ? lu->row(j) : nullptr;
+    const double ylo_n = ylo[j + 1], yhi_n = yhi[j + 1], ylo_s = ylo[j], yhi_s = yhi[j];
+    const double ywij = ywi[j], ydn = ydi[j + 1], yds = ydi[j], ycj = yci[j];
+    for (int i = i0; i < nx; ++i) {
+      const double ue = 0.5 * (uc[i] + uc[i + 1]), uw = 0.5 * (uc[i - 1] + uc[i]);
+      const double be = Upwind ? bc[i] : 0, bw = Upwind ? bc[i - 1] : 0, bfi = Upwind ? bf[i] : 0;
+      const double fx = ue * carried<Upwind>(ue, uc[i], uc[i + 1], be) -
+                        uw * carried<Upwind>(uw, uc[i - 1], uc[i], bw);
+      const double vnn = xlo[i] * vn[i - 1] + xhi[i] * vn[i];
+      const double vss = xlo[i] * vc[i - 1] + xhi[i] * vc[i];
+      double qn, qs;
+      if constexpr (Upwind) {
+        const double cn = ylo_n * uc[i] + yhi_n * un[i], cs = ylo_s * us[i] + yhi_s * uc[i];
+        qn = cn + bfi * ((vnn > 0 ? uc[i] : un[i]) - cn);
+        qs = cs + bfi * ((vss > 0 ? us[i] : uc[i]) - cs);
+      } else {
+        qn = ylo_n * uc[i] + yhi_n * un[i];
+        qs = ylo_s * us[i] + yhi_s * uc[i];
+      }
+      const double fy = vnn * qn - vss * qs;
+      const double lap = ((uc[i + 1] - uc[i]) * xwi[i] - (uc[i] - uc[i - 1]) * xwi[i - 1]) * xdi[i] +
+                         ((un[i] - uc[i]) * ydn - (uc[i] - us[i]) * yds) * ycj;
+      h[i] = -(fx * xdi[i] + fy * ywij) + nu_e * lap;
+      if constexpr (Lap) l[i] = lap;
+    }
+  }
+
+  for (int j = j0; j < ny; ++j) {
+    const double* vc = v.row(j);
+    const double* vn = v.row(j + 1);
+    const double* vs = v.row(j - 1);
+    const double* uc = u.row(j);
+    const double* us = u.row(j - 1);
+    double* h = hv.row(j);
+    double* l = Lap ? lv->row(j) : nullptr;
+    const double ylo_j = ylo[j], yhi_j = yhi[j], ydj = ydi[j], ywn = ywi[j], yws = ywi[j - 1];
+    for (int i = 0; i < nx; ++i) {
+      const double ue = ylo_j * us[i + 1] + yhi_j * uc[i + 1];
+      const double uw = ylo_j * us[i] + yhi_j * uc[i];
+      double qe, qw;
+      if constexpr (Upwind) {
+        const double ce = xlo[i + 1] * vc[i] + xhi[i + 1] * vc[i + 1];
+        const double cw = xlo[i] * vc[i - 1] + xhi[i] * vc[i];
+        qe = ce + bf[i + 1] * ((ue > 0 ? vc[i] : vc[i + 1]) - ce);
+        qw = cw + bf[i] * ((uw > 0 ? vc[i - 1] : vc[i]) - cw);
+      } else {
+        qe = xlo[i + 1] * vc[i] + xhi[i + 1] * vc[i + 1];
+        qw = xlo[i] * vc[i - 1] + xhi[i] * vc[i];
+      }
+      const double fx = ue * qe - uw * qw;
+      const double vnn = 0.5 * (vc[i] + vn[i]), vss = 0.5 * (vs[i] + vc[i]);
+      const double bci = Upwind ? bc[i] : 0;
+      const double fy = vnn * carried<Upwind>(vnn, vc[i], vn[i], bci) -
+                        vss * carried<Upwind>(vss, vs[i], vc[i], bci);
+      const double lap = ((vc[i + 1] - vc[i]) * xdi[i + 1] - (vc[i] - vc[i - 1]) * xdi[i]) * xci[i] +
+                         ((vn[i] - vc[i]) * ywn - (vc[i] - vs[i]) * yws) * ydj;
+      h[i] = -(fx * xwi[i] + fy * ydj) + nu_e * lap;
+      if constexpr (Lap) l[i] = lap;
+    }
+  }
+}
+
+}  // namespace
+
+void momentum_terms(const Grid& g, const SpongeWeights& sw, const Field& u, const Field& v,
+                    double nu_e, int i0, int j0, Field& hu, Field& hv, Field* lu, Field* lv) {
+  const bool lap = lu != nullptr;
+  if (sw.active) {
+    lap ? kernel<true, true>(g, sw, u, v, nu_e, i0, j0, hu, hv, lu, lv)
+        : kernel<true, false>(g, sw, u, v, nu_e, i0, j0, hu, hv, lu, lv);
+  } else {
+    lap ? kernel<false, true>(g, sw, u, v, nu_e, i0, j0, hu, hv, lu, lv)
+        : kernel<false, false>(g, sw, u, v, nu_e, i0, j0, hu, hv, lu, lv);
+  }
+}
+
+}  // namespace fluid

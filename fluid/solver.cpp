@@ -1,0 +1,488 @@
+// One time step of the fluid: predictor, immersed-solid forcing, boundary conditions, Poisson
+// right-hand side, solve, correct.
+#include "solver.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace fluid {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+enum class Loc { pressure, normal, tangential };
+
+// The 1D operator along axis `ax` for a quantity at location `loc`, bounded by sides lo/hi.
+//   pressure (cell centres, finite volume, zero normal gradient at walls):
+//     row k: [(x_{k+1}-x_k)/d_{k+1} - (x_k-x_{k-1})/d_k] / w_k
+//   normal velocity (faces 1..n-1, boundary faces given):
+//     row f: [(x_{f+1}-x_f)/w_f - (x_f-x_{f-1})/w_{f-1}] / d_f
+//   tangential velocity (cell centres, finite difference, ghost rule at the ends):
+//     row k: [(x_{k+1}-x_k)/d_{k+1} - (x_k-x_{k-1})/d_k] * 2 / (c_{k+1} - c_{k-1})
+Operator1D make_operator(const Axis& ax, Loc loc, bool transform, const Boundaries& b, int side_lo) {
+  Operator1D op;
+  const int n = ax.n();
+  op.h = ax.h();
+  if (ax.periodic()) {
+    op.n = n;
+    op.lo = op.hi = Closure::periodic;
+    return op;
+  }
+  const double *wi = ax.wi(), *di = ax.di(), *ci = ax.ci();
+  if (loc == Loc::normal) {
+    op.n = n - 1;
+    op.lo = op.hi = Closure::dirichlet_node;
+    if (transform) return op;
+    op.a.resize(n - 1);
+    op.b.resize(n - 1);
+    op.c.resize(n - 1);
+    for (int f = 1; f < n; ++f) {
+      op.a[f - 1] = wi[f - 1] * di[f];
+      op.c[f - 1] = wi[f] * di[f];
+      op.b[f - 1] = -(op.a[f - 1] + op.c[f - 1]);
+    }
+    op.a[0] = 0;
+    op.c[n - 2] = 0;
+    return op;
+  }
+  op.n = n;
+  op.a.resize(n);
+  op.b.resize(n);
+  op.c.resize(n);
+  for (int k = 0; k < n; ++k) {
+    const double s = loc == Loc::pressure ? wi[k] : ci[k];
+    op.a[k] = di[k] * s;
+    op.c[k] = di[k + 1] * s;
+    op.b[k] = -(op.a[k] + op.c[k]);
+  }
+  if (loc == Loc::pressure) {
+    op.lo = op.hi = Closure::neumann_half;
+    op.b[0] = -op.c[0];
+    op.b[n - 1] = -op.a[n - 1];
+    op.singular = true;
+  } else {
+    for (int e = 0; e < 2; ++e) {
+      const int side = side_lo + e;
+      const bool slip = b.side(side).type == BcType::slip;
+      (e == 0 ? op.lo : op.hi) = slip ? Closure::neumann_half : Closure::dirichlet_half;
+      // Fold the ghost rule g = ga q0 + gb q1 (+ data, on the right-hand side) into the row.
+      const GhostRule& r = b.rule(side);
+      const int k = e == 0 ? 0 : n - 1, k1 = e == 0 ? 1 : n - 2;
+      double& gcoef = e == 0 ? op.a[0] : op.c[n - 1];
+      op.b[k] += gcoef * (r.is_data ? 0.0 : r.ga);
+      (k1 > k ? op.c[k] : op.a[k]) += gcoef * (r.is_data ? 0.0 : r.gb);
+      gcoef = 0;
+    }
+  }
+  if (transform) {
+    op.a.clear();
+    op.b.clear();
+    op.c.clear();
+  }
+  return op;
+}
+
+}  // namespace
+
+Solver::Solver(const Config& c, double dt)
+    : m_cfg(c),
+      m_grid(
+          [&] {
+            AxisSpec x = c.x;
+            x.periodic = c.bc[left].type == BcType::periodic;
+            return x;
+          }(),
+          [&] {
+            AxisSpec y = c.y;
+            y.periodic = c.bc[bottom].type == BcType::periodic;
+            return y;
+          }()),
+      m_bnd(m_grid, c.bc),
+      m_sponge(sponge_weights(m_grid)) {
+  validate(c, dt);
+  m_nu = c.viscosity / c.density;
+  const int nx = m_grid.nx(), ny = m_grid.ny();
+  m_t_axis = m_grid.x().uniform() ? 0 : 1;
+  m_i0 = m_grid.x().periodic() ? 0 : 1;
+  m_j0 = m_grid.y().periodic() ? 0 : 1;
+  m_u = Field(nx + 1, ny);
+  m_v = Field(nx, ny + 1);
+  m_p = Field(nx, ny);
+  m_phi = Field(nx, ny);
+  m_hu = m_hu_old = Field(nx + 1, ny);
+  m_hv = m_hv_old = Field(nx, ny + 1);
+
+  const Axis& T = m_grid.axis(m_t_axis);
+  const Axis& S = m_grid.axis(1 - m_t_axis);
+  const int side_t = 2 * m_t_axis, side_s = 2 * (1 - m_t_axis);
+  m_poisson = std::make_unique<FastSolver>(make_operator(T, Loc::pressure, true, m_bnd, side_t),
+                                           make_operator(S, Loc::pressure, false, m_bnd, side_s), 0.0);
+  std::vector<double> w(S.n());
+  for (int j = 0; j < S.n(); ++j) w[j] = S.width(j);
+  m_poisson->set_mean_weights(w);
+  if (c.implicit) {
+    m_lu = Field(nx + 1, ny);
+    m_lv = Field(nx, ny + 1);
+    build_implicit(dt);
+  }
+  m_bnd.fill_ghosts(m_u, m_v, 0.0);
+}
+
+Solver::~Solver() = default;
+
+// Helmholtz operators of Crank-Nicolson: (L - 2/(nu dt)) for u and for v.
+void Solver::build_implicit(double dt) {
+  const double sigma = 2.0 / (m_nu * dt);
+  const Axis& T = m_grid.axis(m_t_axis);
+  const Axis& S = m_grid.axis(1 - m_t_axis);
+  const int side_t = 2 * m_t_axis, side_s = 2 * (1 - m_t_axis);
+  for (int comp = 0; comp < 2; ++comp) {
+    const Loc lt = comp == m_t_axis ? Loc::normal : Loc::tangential;
+    const Loc ls = comp == m_t_axis ? Loc::tangential : Loc::normal;
+    auto solver = std::make_unique<FastSolver>(make_operator(T, lt, true, m_bnd, side_t),
+                                               make_operator(S, ls, false, m_bnd, side_s), sigma);
+    (comp == 0 ? m_helm_u : m_helm_v) = std::move(solver);
+  }
+  m_dt_implicit = dt;
+}
+
+std::array<double, 2> Solver::body_acceleration(double t) const {
+  const double s = m_cfg.period > 0 ? std::sin(2 * std::numbers::pi * t / m_cfg.period + m_cfg.phase) : 0.0;
+  std::array<double, 2> a;
+  for (int d = 0; d < 2; ++d) {
+    a[d] = (m_cfg.body[d] + m_cfg.oscillating[d] * s) / m_cfg.density + m_cfg.gravity[d];
+  }
+  return a;
+}
+
+void Solver::step(double dt) {
+  static const CouplingIn none{};
+  CouplingOut out;
+  step(dt, none, out);
+}
+
+void Solver::step(double dt, const CouplingIn& in, CouplingOut& out) {
+  if (!(dt > 0)) throw std::invalid_argument("fluid::Solver::step: dt must be > 0");
+  const double t_new = m_t + dt;
+  auto t0 = Clock::now();
+  // Explicit terms at t^n (ghosts of u^n are filled).
+  const bool imp = m_cfg.implicit;
+  momentum_terms(m_grid, m_sponge, m_u, m_v, imp ? 0.0 : m_nu, m_i0, m_j0, m_hu, m_hv,
+                 imp ? &m_lu : nullptr, imp ? &m_lv : nullptr);
+  m_time.predictor += since(t0);
+
+  // Boundary values at t^{n+1}; Crank-Nicolson also needs the ghosts with the new wall data.
+  t0 = Clock::now();
+  m_bnd.advance_normal(m_u, m_v, t_new, dt);
+  if (imp) m_bnd.fill_ghosts(m_u, m_v, t_new);
+  m_time.boundaries += since(t0);
+
+  t0 = Clock::now();
+  if (m_step == 0) m_dt_prev = dt;
+  if (imp) {
+    if (dt != m_dt_implicit) build_implicit(dt);
+    predictor_implicit(dt, m_t + 0.5 * dt, &in);
+  } else {
+    predictor(dt, m_t + 0.5 * dt, &in);
+  }
+  immersed_forcing(dt, in, out);
+  m_time.predictor += since(t0);
+
+  project(dt);
+
+  t0 = Clock::now();
+  m_bnd.fill_ghosts(m_u, m_v, t_new);
+  const int nu = m_grid.nu(), nx = m_grid.nx();
+  out.sample_u.resize(in.sample_u_index.size());
+  out.sample_v.resize(in.sample_v_index.size());
+  for (std::size_t q = 0; q < in.sample_u_index.size(); ++q) {
+    const auto idx = in.sample_u_index[q];
+    out.sample_u[q] = m_u(int(idx % nu), int(idx / nu));
+  }
+  for (std::size_t q = 0; q < in.sample_v_index.size(); ++q) {
+    const auto idx = in.sample_v_index[q];
+    out.sample_v[q] = m_v(int(idx % nx), int(idx / nx));
+  }
+  m_time.boundaries += since(t0);
+
+  std::swap(m_hu, m_hu_old);
+  std::swap(m_hv, m_hv_old);
+  m_dt_prev = dt;
+  m_t = t_new;
+  ++m_step;
+  ++m_time.steps;
+}
+
+// Explicit predictor (AB2 for convection and diffusion, Euler on the first step):
+//   u~ = u^n + dt [ (1 + dt/(2 dt')) H^n - dt/(2 dt') H^{n-1} - G p^n / rho + f(t^{n+1/2}) / rho
+//                   + f_f / rho ],   H = -div(u u) + nu lap(u)
+void Solver::predictor(double dt, double t_half, const CouplingIn* in) {
+  const double c1 = m_step == 0 ? 1.0 : 1.0 + 0.5 * dt / m_dt_prev;
+  const double c0 = m_step == 0 ? 0.0 : -0.5 * dt / m_dt_prev;
+  const auto acc = body_acceleration(t_half);
+  const double ri = 1.0 / m_cfg.density;
+  const int nx = m_grid.nx(), ny = m_grid.ny();
+  const double* xdi = m_grid.x().di();
+  const double* ydi = m_grid.y().di();
+  for (int j = 0; j < ny; ++j) {
+    double* u = m_u.row(j);
+    const double* h = m_hu.row(j);
+    const double* ho = m_hu_old.row(j);
+    const double* p = m_p.row(j);
+    for (int i = m_i0; i < nx; ++i) {
+      u[i] += dt * (c1 * h[i] + c0 * ho[i] + acc[0] - ri * (p[i] - p[i - 1]) * xdi[i]);
+    }
+  }
+  for (int j = m_j0; j < ny; ++j) {
+    double* v = m_v.row(j);
+    const double* h = m_hv.row(j);
+    const double* ho = m_hv_old.row(j);
+    const double* p = m_p.row(j);
+    const double* ps = m_p.row(j - 1);
+    const double gy = ri * ydi[j];
+    for (int i = 0; i < nx; ++i) {
+      v[i] += dt * (c1 * h[i] + c0 * ho[i] + acc[1] - gy * (p[i] - ps[i]));
+    }
+  }
+  if (!in) return;
+  const int nu = m_grid.nu();
+  for (std::size_t q = 0; q < in->fiber_u_index.size(); ++q) {
+    const auto idx = in->fiber_u_index[q];
+    const int i = int(idx % nu), j = int(idx / nu);
+    if (i >= m_i0 && i < nx) m_u(i, j) += dt * ri * in->fiber_u_force[q];
+  }
+  for (std::size_t q = 0; q < in->fiber_v_index.size(); ++q) {
+    const auto idx = in->fiber_v_index[q];
+    const int i = int(idx % nx), j = int(idx / nx);
+    if (j >= m_j0 && j < ny) m_v(i, j) += dt * ri * in->fiber_v_force[q];
+  }
+}
+
+// Crank-Nicolson predictor, theta = nu dt / 2:
+//   (I - theta L) u~ = u^n + dt [AB2(-div(u u)) - G p^n / rho + f / rho + f_f / rho]
+//                      + theta L u^n + theta b^{n+1}
+// with b^{n+1} the boundary data at t^{n+1}. L is solved as the fast solver's L0, which equals L
+// except in the transform direction next to a wall or an outflow, where L0 uses the nearest
+// closure a real transform diagonalises (ghost -q0 or +q0). The difference is carried
+// explicitly with u^n, so a steady state is that of L exactly; this is stable for
+// nu dt / h_t^2 < 2 (checked by validate()).
+void Solver::predictor_implicit(double dt, double t_half, const CouplingIn* in) {
+  const double c1 = m_step == 0 ? 1.0 : 1.0 + 0.5 * dt / m_dt_prev;
+  const double c0 = m_step == 0 ? 0.0 : -0.5 * dt / m_dt_prev;
+  const auto acc = body_acceleration(t_half);
+  const double ri = 1.0 / m_cfg.density;
+  const double theta = 0.5 * m_nu * dt, scale = -1.0 / theta;
+  const int nx = m_grid.nx(), ny = m_grid.ny();
+  const Axis& X = m_grid.x();
+  const Axis& Y = m_grid.y();
+
+  for (int comp = 0; comp < 2; ++comp) {
+    Field& F = comp == 0 ? m_u : m_v;
+    const Field& H = comp == 0 ? m_hu : m_hv;
+    const Field& Ho = comp == 0 ? m_hu_old : m_hv_old;
+    const Field& L = comp == 0 ? m_lu : m_lv;
+    FastSolver& hs = comp == 0 ? *m_helm_u : *m_helm_v;
+    const int ib = comp == 0 ? m_i0 : 0, jb = comp == 0 ? 0 : m_j0;
+    const int nt = hs.nt();
+    double* buf = hs.data();
+    const double* gd = comp == 0 ? X.di() : Y.di();
+    for (int j = jb; j < ny; ++j) {
+      const double* f = F.row(j);
+      const double* h = H.row(j);
+      const double* ho = Ho.row(j);
+      const double* l = L.row(j);
+      const double* p = m_p.row(j);
+      const double* pm = comp == 0 ? p - 1 : m_p.row(j - 1);  // p at the face's low side
+      for (int i = ib; i < nx; ++i) {
+        const double gp = (p[i] - pm[i]) * (comp == 0 ? gd[i] : gd[j]);
+        const double rhs = f[i] + dt * (c1 * h[i] + c0 * ho[i] + acc[comp] - ri * gp) + theta * l[i];
+        buf[buf_index(i, j, ib, jb, nt)] = scale * rhs;
+      }
+    }
+    // Boundary rows: theta * coef * (value beyond the row at t^{n+1} - what the solved operator
+    // assumes there).
+    for (int s = 0; s < 4; ++s) {
+      const SideBc& bc = m_bnd.side(s);
+      if (bc.type == BcType::periodic) continue;
+      const int a = s / 2;
+      const bool hi = s % 2;
+      const Axis& ax = m_grid.axis(a);
+      const int n = ax.n();
+      const int kb = a == 0 ? jb : ib, ke = a == 0 ? ny : nx;  // range along the side
+      auto val = [&](int nidx, int k) { return a == 0 ? F(nidx, k) : F(k, nidx); };
+      auto add = [&](int nidx, int k, double x) {
+        const int i = a == 0 ? nidx : k, j = a == 0 ? k : nidx;
+        buf[buf_index(i, j, ib, jb, nt)] += scale * theta * x;
+      };
+      if (a == comp) {  // normal component: boundary face value
+        const int b = hi ? n : 0, f = hi ? n - 1 : 1;
+        const double coef = hi ? ax.wi()[n - 1] * ax.di()[n - 1] : ax.wi()[0] * ax.di()[1];
+        for (int k = kb; k < ke; ++k) add(f, k, coef * val(b, k));
+      } else {  // tangential component: ghost value
+        const int g = hi ? n : -1, q0 = hi ? n - 1 : 0, q1 = hi ? n - 2 : 1;
+        const double coef = hi ? ax.di()[n] * ax.ci()[n - 1] : ax.di()[0] * ax.ci()[0];
+        const GhostRule& r = m_bnd.rule(s);
+        const bool in_transform = a == m_t_axis;
+        const double sgn = bc.type == BcType::slip ? 1.0 : -1.0;
+        for (int k = kb; k < ke; ++k) {
+          const double assumed = in_transform ? sgn * val(q0, k)
+                                 : r.is_data  ? 0.0
+                                              : r.ga * val(q0, k) + r.gb * val(q1, k);
+          add(q0, k, coef * (val(g, k) - assumed));
+        }
+      }
+    }
+    if (in) {
+      const auto& idx = comp == 0 ? in->fiber_u_index : in->fiber_v_index;
+      const auto& frc = comp == 0 ? in->fiber_u_force : in->fiber_v_force;
+      const int nu = m_grid.nu();
+      for (std::size_t q = 0; q < idx.size(); ++q) {
+        const int i = comp == 0 ? int(idx[q] % nu) : int(idx[q] % nx);
+        const int j = comp == 0 ? int(idx[q] / nu) : int(idx[q] / nx);
+        if (i < ib || i >= nx || j < jb || j >= ny) continue;
+        buf[buf_index(i, j, ib, jb, nt)] += scale * dt * ri * frc[q];
+      }
+    }
+    hs.solve();
+    for (int j = jb; j < ny; ++j) {
+      double* f = F.row(j);
+      for (int i = ib; i < nx; ++i) f[i] = buf[buf_index(i, j, ib, jb, nt)];
+    }
+  }
+}
+
+// Immersed solid (paper Eq. 21): f_s = rho_f alpha (u_s - u~) / dt, then u~ += dt f_s / rho_f,
+// i.e. u~ <- (1 - alpha) u~ + alpha u_s, on the solid's faces.
+void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out) {
+  const double rho = m_cfg.density;
+  const int nx = m_grid.nx(), ny = m_grid.ny(), nu = m_grid.nu();
+  out.solid_u_force.resize(in.solid_u_index.size());
+  out.solid_v_force.resize(in.solid_v_index.size());
+  for (std::size_t q = 0; q < in.solid_u_index.size(); ++q) {
+    const auto idx = in.solid_u_index[q];
+    const int i = int(idx % nu), j = int(idx / nu);
+    double f = 0;
+    if (i >= m_i0 && i < nx) {
+      double& u = m_u(i, j);
+      f = rho * in.solid_u_alpha[q] * (in.solid_u_velocity[q] - u) / dt;
+      u += dt * f / rho;
+    }
+    out.solid_u_force[q] = f;
+  }
+  for (std::size_t q = 0; q < in.solid_v_index.size(); ++q) {
+    const auto idx = in.solid_v_index[q];
+    const int i = int(idx % nx), j = int(idx / nx);
+    double f = 0;
+    if (j >= m_j0 && j < ny) {
+      double& v = m_v(i, j);
+      f = rho * in.solid_v_alpha[q] * (in.solid_v_velocity[q] - v) / dt;
+      v += dt * f / rho;
+    }
+    out.solid_v_force[q] = f;
+  }
+}
+
+// Projection: L phi = (rho / dt) D u~ (Neumann at non-periodic sides), then
+//   u^{n+1} = u~ - (dt / rho) G phi,   p^{n+1} = p^n + phi.
+// D G is exactly the operator the fast solver inverts, so D u^{n+1} = 0 to round-off.
+void Solver::project(double dt) {
+  auto t0 = Clock::now();
+  const int nx = m_grid.nx(), ny = m_grid.ny();
+  const double *xwi = m_grid.x().wi(), *ywi = m_grid.y().wi();
+  const double *xdi = m_grid.x().di(), *ydi = m_grid.y().di();
+  FastSolver& ps = *m_poisson;
+  double* buf = ps.data();
+  const int nt = ps.nt();
+  const double k = m_cfg.density / dt;
+  // The duplicate face of a periodic direction carries the value of face 0.
+  if (m_grid.x().periodic())
+    for (int j = 0; j < ny; ++j) m_u(nx, j) = m_u(0, j);
+  if (m_grid.y().periodic())
+    for (int i = 0; i < nx; ++i) m_v(i, ny) = m_v(i, 0);
+  for (int j = 0; j < ny; ++j) {
+    const double* u = m_u.row(j);
+    const double* v = m_v.row(j);
+    const double* vn = m_v.row(j + 1);
+    const double wy = ywi[j];
+    if (m_t_axis == 0) {
+      double* b = buf + std::size_t(nt) * j;
+      for (int i = 0; i < nx; ++i) b[i] = k * ((u[i + 1] - u[i]) * xwi[i] + (vn[i] - v[i]) * wy);
+    } else {
+      for (int i = 0; i < nx; ++i) {
+        buf[j + std::size_t(nt) * i] = k * ((u[i + 1] - u[i]) * xwi[i] + (vn[i] - v[i]) * wy);
+      }
+    }
+  }
+  ps.solve();
+  m_time.poisson += since(t0);
+
+  t0 = Clock::now();
+  for (int j = 0; j < ny; ++j) {
+    double* phi = m_phi.row(j);
+    double* p = m_p.row(j);
+    for (int i = 0; i < nx; ++i) {
+      phi[i] = buf[buf_index(i, j, 0, 0, nt)];
+      p[i] += phi[i];
+    }
+  }
+  m_bnd.fill_scalar(m_phi);
+  m_bnd.fill_scalar(m_p);
+  const double c = dt / m_cfg.density;
+  for (int j = 0; j < ny; ++j) {
+    double* u = m_u.row(j);
+    const double* phi = m_phi.row(j);
+    for (int i = m_i0; i < nx; ++i) u[i] -= c * (phi[i] - phi[i - 1]) * xdi[i];
+  }
+  for (int j = m_j0; j < ny; ++j) {
+    double* v = m_v.row(j);
+    const double* phi = m_phi.row(j);
+    const double* phs = m_phi.row(j - 1);
+    const double cy = c * ydi[j];
+    for (int i = 0; i < nx; ++i) v[i] -= cy * (phi[i] - phs[i]);
+  }
+  m_time.projection += since(t0);
+}
+
+void Solver::project_initial() {
+  m_bnd.advance_normal(m_u, m_v, m_t, 0.0);
+  const Field p = m_p;
+  project(1.0);
+  m_p = p;
+  m_bnd.fill_ghosts(m_u, m_v, m_t);
+}
+
+void set_initial(Solver& s) {
+  const Initial& in = s.config().initial;
+  const Grid& g = s.grid();
+  const int nx = g.nx(), ny = g.ny();
+  const double pi = std::numbers::pi;
+  auto velocity = [&](double x, double y) -> std::array<double, 2> {
+    switch (in.type) {
+      case InitialType::rest: return {0, 0};
+      case InitialType::uniform: return in.velocity;
+      case InitialType::taylor_green: {
+        const double kx = 2 * pi / g.x().length(), ky = 2 * pi / g.y().length();
+        const double X = x - g.x().lo(), Y = y - g.y().lo();
+        return {-in.amplitude * std::cos(kx * X) * std::sin(ky * Y),
+                in.amplitude * (kx / ky) * std::sin(kx * X) * std::cos(ky * Y)};
+      }
+      case InitialType::vortex: {
+        const double dx = x - in.centre[0], dy = y - in.centre[1];
+        const double r2 = (dx * dx + dy * dy) / (in.radius * in.radius);
+        const double w = in.amplitude / in.radius * std::exp(0.5 * (1 - r2));  // v_theta / r
+        return {in.velocity[0] - w * dy, in.velocity[1] + w * dx};
+      }
+    }
+    return {0, 0};
+  };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i <= nx; ++i) s.u()(i, j) = velocity(g.x().face(i), g.y().centre(j))[0];
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i < nx; ++i) s.v()(i, j) = velocity(g.x().centre(i), g.y().face(j))[1];
+  s.project_initial();
+}
+
+}  // namespace fluid

@@ -1,0 +1,127 @@
+// The fluid solver: 2D incompressible Navier-Stokes on a MAC grid, fractional step with AB2
+// convection (Euler on the first step), explicit AB2 or Crank-Nicolson diffusion, incremental
+// pressure projection with an exact direct Poisson solve. One step reads as the paper's
+// procedure (DESIGN.md section 3, step 4): predictor (with the fibers' force f_f), immersed-
+// solid forcing f_s, boundary conditions, Poisson right-hand side, solve, correct.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "boundary.hpp"
+#include "config.hpp"
+#include "fast_solver.hpp"
+#include "field.hpp"
+#include "grid.hpp"
+#include "momentum.hpp"
+
+namespace fluid {
+
+// The coupling hook. Face indexing (flat, as the coupler sees it):
+//   u face (i, j) sits at (x_face(i), y_centre(j)), i in [0, nu), nu = nx if x is periodic else
+//   nx + 1, j in [0, ny): index i + nu * j.
+//   v face (i, j) sits at (x_centre(i), y_face(j)), i in [0, nx), j in [0, nv), nv = ny if y is
+//   periodic else ny + 1: index i + nx * j.
+// Input of one step (all spans may be empty; they must stay valid during step()):
+//   solid_*: immersed solid on the footprint: index, volume fraction alpha in [0, 1] and the mean
+//            solid velocity component (u on u faces, v on v faces) over the control volume.
+//   fiber_*: body force per unit volume f_f from the fibers (any indices, may differ from the
+//            solid's), added in the predictor.
+//   sample_*: faces whose new velocity u^(n+1) is returned.
+// Faces on a non-periodic boundary carry a prescribed velocity: forcing there is ignored and
+// their f_s is returned as 0.
+struct CouplingIn {
+  std::span<const std::int64_t> solid_u_index, solid_v_index;
+  std::span<const double> solid_u_alpha, solid_u_velocity, solid_v_alpha, solid_v_velocity;
+  std::span<const std::int64_t> fiber_u_index, fiber_v_index;
+  std::span<const double> fiber_u_force, fiber_v_force;
+  std::span<const std::int64_t> sample_u_index, sample_v_index;
+};
+// Output of one step:
+//   solid_*_force: f_s = rho_f alpha (u_s - u~) / dt on the solid's faces, in the input order,
+//                  force per unit volume ON THE FLUID (the solid receives its reaction).
+//   sample_*:      u^(n+1) on the requested faces, in the input order.
+struct CouplingOut {
+  std::vector<double> solid_u_force, solid_v_force;
+  std::vector<double> sample_u, sample_v;
+};
+
+// Seconds spent per phase, accumulated over steps.
+struct Timings {
+  double predictor = 0, boundaries = 0, poisson = 0, projection = 0;
+  long steps = 0;
+};
+
+class Solver {
+ public:
+  // dt: the time step the implicit operators are built for (they are rebuilt if it changes).
+  Solver(const Config& c, double dt);
+  ~Solver();
+
+  const Config& config() const { return m_cfg; }
+  const Grid& grid() const { return m_grid; }
+  const Boundaries& boundaries() const { return m_bnd; }
+  double time() const { return m_t; }
+  long step_count() const { return m_step; }
+  // Axis whose direction the fast solver transforms (0 = x, 1 = y).
+  int transform_axis() const { return m_t_axis; }
+
+  void step(double dt);
+  void step(double dt, const CouplingIn& in, CouplingOut& out);
+
+  // Fields. u: (nx+1) x ny, v: nx x (ny+1), p: nx x ny, with ghosts (Field). After set-up of
+  // u and v by hand, call project_initial().
+  Field& u() { return m_u; }
+  Field& v() { return m_v; }
+  Field& p() { return m_p; }
+  const Field& u() const { return m_u; }
+  const Field& v() const { return m_v; }
+  const Field& p() const { return m_p; }
+  // Make the current velocity discretely divergence-free (boundary values at the current time).
+  void project_initial();
+  // Restart support: the AB2 history and the clock.
+  const Field& convection_u() const { return m_hu_old; }
+  const Field& convection_v() const { return m_hv_old; }
+
+  // First active u column (0 if x periodic, else 1) and v row.
+  int i0() const { return m_i0; }
+  int j0() const { return m_j0; }
+
+  const Timings& timings() const { return m_time; }
+  void reset_timings() { m_time = {}; }
+  // Acceleration of the body force at time t (force per unit volume / rho + g).
+  std::array<double, 2> body_acceleration(double t) const;
+  // The bare Poisson solver (for the benchmark's floor and tests).
+  FastSolver& poisson() { return *m_poisson; }
+
+ private:
+  void build_implicit(double dt);
+  void predictor(double dt, double t_half, const CouplingIn* in);
+  void predictor_implicit(double dt, double t_half, const CouplingIn* in);
+  void immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out);
+  void project(double dt);
+  int buf_index(int i, int j, int i_first, int j_first, int nt) const {
+    return m_t_axis == 0 ? (i - i_first) + nt * (j - j_first) : (j - j_first) + nt * (i - i_first);
+  }
+
+  Config m_cfg;
+  Grid m_grid;
+  Boundaries m_bnd;
+  SpongeWeights m_sponge;
+  int m_t_axis = 0;
+  int m_i0 = 0, m_j0 = 0;
+  double m_t = 0, m_dt_prev = 0, m_dt_implicit = 0;
+  long m_step = 0;
+  double m_nu = 0;
+  Field m_u, m_v, m_p, m_phi;
+  Field m_hu, m_hv, m_hu_old, m_hv_old, m_lu, m_lv;
+  std::unique_ptr<FastSolver> m_poisson, m_helm_u, m_helm_v;
+  Timings m_time;
+};
+
+// Set the initial velocity of the configuration (rest, uniform, Taylor-Green, vortex) and project.
+void set_initial(Solver& s);
+
+}  // namespace fluid

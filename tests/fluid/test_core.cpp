@@ -1,0 +1,229 @@
+// Exactness of the fast Poisson solve and the projection, Taylor-Green convergence order and
+// exact plane Poiseuille flow on the MAC grid.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "diagnostics.hpp"
+#include "solver.hpp"
+
+using namespace fluid;
+
+namespace {
+
+Config channel(int nx, int ny, BcType x_bc, BcType y_bc) {
+  Config c;
+  c.density = 1;
+  c.viscosity = 0.1;
+  c.x = {nx, 2.0, 0.0};
+  c.y = {ny, 1.0, 0.0};
+  c.bc[left].type = c.bc[right].type = x_bc;
+  c.bc[bottom].type = c.bc[top].type = y_bc;
+  c.cfl_max = 1e9;
+  return c;
+}
+
+// A random field made discretely compatible, projected: the divergence must vanish to round-off.
+double projected_divergence(Config c) {
+  Solver s(c, 1e-4);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> d(-1, 1);
+  for (int j = 0; j < s.grid().ny(); ++j)
+    for (int i = s.i0(); i < s.grid().nx(); ++i) s.u()(i, j) = d(rng);
+  for (int j = s.j0(); j < s.grid().ny(); ++j)
+    for (int i = 0; i < s.grid().nx(); ++i) s.v()(i, j) = d(rng);
+  s.project_initial();
+  return max_divergence(s).value;
+}
+
+}  // namespace
+
+TEST_CASE("projection leaves a divergence at round-off", "[fluid][projection]") {
+  CHECK(projected_divergence(channel(32, 24, BcType::periodic, BcType::periodic)) < 1e-11);
+  CHECK(projected_divergence(channel(32, 24, BcType::periodic, BcType::wall)) < 1e-11);
+  CHECK(projected_divergence(channel(30, 20, BcType::wall, BcType::wall)) < 1e-11);
+  CHECK(projected_divergence(channel(30, 20, BcType::wall, BcType::periodic)) < 1e-11);
+  Config st = channel(32, 24, BcType::periodic, BcType::wall);
+  st.y.tanh_beta = 1.5;
+  CHECK(projected_divergence(st) < 1e-10);
+  Config sp = channel(32, 24, BcType::wall, BcType::wall);
+  sp.bc[right].type = BcType::outflow;
+  sp.x.sponge_cells = 8;
+  sp.x.sponge_ratio = 1.2;
+  CHECK(projected_divergence(sp) < 1e-10);
+}
+
+TEST_CASE("fast solver inverts the discrete operator exactly", "[fluid][poisson]") {
+  // Manufactured discrete solution: x random, r = (L - sigma) x by the 1D stencils, solve.
+  for (auto [lo, hi] : {std::pair{Closure::periodic, Closure::periodic},
+                        {Closure::neumann_half, Closure::neumann_half},
+                        {Closure::dirichlet_half, Closure::dirichlet_half},
+                        {Closure::dirichlet_half, Closure::neumann_half},
+                        {Closure::neumann_half, Closure::dirichlet_half},
+                        {Closure::dirichlet_node, Closure::dirichlet_node}}) {
+    const int nt = 12, ns = 9;
+    const double h = 0.3, sigma = 2.5;
+    Operator1D t{nt, lo, hi, h, {}, {}, {}, false};
+    // A stretched tridiagonal direction with Dirichlet-like ends.
+    Operator1D s;
+    s.n = ns;
+    s.a.resize(ns);
+    s.b.resize(ns);
+    s.c.resize(ns);
+    for (int j = 0; j < ns; ++j) {
+      s.a[j] = j > 0 ? 1.0 + 0.1 * j : 0.0;
+      s.c[j] = j < ns - 1 ? 1.2 - 0.05 * j : 0.0;
+      s.b[j] = -(2.3 + 0.1 * j);
+    }
+    FastSolver fs(t, s, sigma);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> d(-1, 1);
+    std::vector<double> x(nt * ns), r(nt * ns);
+    for (auto& q : x) q = d(rng);
+    auto X = [&](int k, int j) -> double {
+      if (j < 0 || j >= ns) return 0.0;
+      if (k < 0 || k >= nt) {
+        const bool low = k < 0;
+        const Closure cl = low ? lo : hi;
+        const int kk = low ? 0 : nt - 1;
+        switch (cl) {
+          case Closure::periodic: return x[((k + nt) % nt) + nt * j];
+          case Closure::neumann_half: return x[kk + nt * j];
+          case Closure::dirichlet_half: return -x[kk + nt * j];
+          case Closure::dirichlet_node: return 0.0;
+        }
+      }
+      return x[k + nt * j];
+    };
+    for (int j = 0; j < ns; ++j)
+      for (int k = 0; k < nt; ++k)
+        r[k + nt * j] = (X(k + 1, j) - 2 * X(k, j) + X(k - 1, j)) / (h * h) + s.a[j] * X(k, j - 1) +
+                        s.b[j] * X(k, j) + s.c[j] * X(k, j + 1) - sigma * X(k, j);
+    std::copy(r.begin(), r.end(), fs.data());
+    fs.solve();
+    double err = 0;
+    for (int q = 0; q < nt * ns; ++q) err = std::max(err, std::abs(fs.data()[q] - x[q]));
+    CHECK(err < 1e-12);
+  }
+}
+
+TEST_CASE("pressure Poisson problem solved exactly on a stretched grid", "[fluid][poisson]") {
+  // p random; r = D G p with zero-flux walls; the solve returns p up to a constant.
+  Config c = channel(16, 12, BcType::periodic, BcType::wall);
+  c.y.tanh_beta = 2.0;
+  Solver s(c, 1e-4);
+  const Grid& g = s.grid();
+  const int nx = g.nx(), ny = g.ny();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> d(-1, 1);
+  Field p(nx, ny);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) p(i, j) = d(rng);
+  s.boundaries().fill_scalar(p);
+  FastSolver& ps = s.poisson();
+  const double *xwi = g.x().wi(), *xdi = g.x().di(), *ywi = g.y().wi(), *ydi = g.y().di();
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const double gn = j < ny - 1 ? (p(i, j + 1) - p(i, j)) * ydi[j + 1] : 0.0;
+      const double gs = j > 0 ? (p(i, j) - p(i, j - 1)) * ydi[j] : 0.0;
+      const double lx = ((p(i + 1, j) - p(i, j)) * xdi[i + 1] - (p(i, j) - p(i - 1, j)) * xdi[i]) * xwi[i];
+      ps.data()[i + nx * j] = lx + (gn - gs) * ywi[j];
+    }
+  ps.solve();
+  const double shift = ps.data()[0] - p(0, 0);
+  double err = 0;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) err = std::max(err, std::abs(ps.data()[i + nx * j] - shift - p(i, j)));
+  CHECK(err < 1e-11);
+}
+
+namespace {
+
+// L2 velocity error of the Taylor-Green vortex at time t_end on n x n cells of [0, 2 pi]^2.
+double taylor_green_error(int n, bool implicit, double dt, double t_end) {
+  Config c;
+  c.density = 1;
+  c.viscosity = 0.05;
+  const double L = 2 * std::numbers::pi;
+  c.x = {n, L, 0.0};
+  c.y = {n, L, 0.0};
+  for (auto& b : c.bc) b.type = BcType::periodic;
+  c.implicit = implicit;
+  c.initial.type = InitialType::taylor_green;
+  c.initial.amplitude = 1;
+  Solver s(c, dt);
+  set_initial(s);
+  const long steps = std::lround(t_end / dt);
+  for (long k = 0; k < steps; ++k) s.step(dt);
+  const double decay = std::exp(-2 * c.viscosity * s.time());
+  const Grid& g = s.grid();
+  double e = 0;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const double ue = -std::cos(g.x().face(i)) * std::sin(g.y().centre(j)) * decay;
+      const double ve = std::sin(g.x().centre(i)) * std::cos(g.y().face(j)) * decay;
+      e += (std::pow(s.u()(i, j) - ue, 2) + std::pow(s.v()(i, j) - ve, 2)) * g.x().h() * g.y().h();
+    }
+  return std::sqrt(e / (2 * L * L));
+}
+
+}  // namespace
+
+TEST_CASE("Taylor-Green vortex converges at second order in space and time", "[fluid][tg]") {
+  for (bool implicit : {false, true}) {
+    // Space: dt small and refined with h^2 so that the spatial error dominates.
+    const double e16 = taylor_green_error(16, implicit, 0.02, 1.0);
+    const double e32 = taylor_green_error(32, implicit, 0.005, 1.0);
+    const double order = std::log2(e16 / e32);
+    INFO("implicit " << implicit << " e16 " << e16 << " e32 " << e32 << " order " << order);
+    CHECK(order >= 1.9);
+  }
+}
+
+TEST_CASE("plane Poiseuille flow reaches the exact parabola", "[fluid][poiseuille]") {
+  for (int variant = 0; variant < 3; ++variant) {
+    Config c = channel(8, 16, BcType::periodic, BcType::wall);
+    c.viscosity = 1;
+    c.body = {2.0, 0.0};  // -dp/dx = G = 2: u = G / (2 mu) y (H - y)
+    if (variant == 1) c.y.tanh_beta = 1.2;
+    double dt = 0.25 * explicit_diffusion_limit(c);
+    if (variant == 2) {
+      c.implicit = true;
+      dt = 0.01;
+    }
+    Solver s(c, dt);
+    set_initial(s);
+    const long steps = std::lround(3.0 / dt);  // ~30 decay times of the slowest mode
+    for (long k = 0; k < steps; ++k) s.step(dt);
+    double err = 0;
+    for (int j = 0; j < s.grid().ny(); ++j) {
+      const double y = s.grid().y().centre(j);
+      for (int i = 0; i < s.grid().nx(); ++i) err = std::max(err, std::abs(s.u()(i, j) - y * (1 - y)));
+    }
+    INFO("variant " << variant << " max error " << err);
+    CHECK(err < 1e-10);
+  }
+}
+
+TEST_CASE("Crank-Nicolson with walls across the transform direction keeps the exact steady state",
+          "[fluid][poiseuille]") {
+  // Walls at x = 0, 2 (the transform direction), periodic in y, force along y.
+  Config c = channel(16, 8, BcType::wall, BcType::periodic);
+  c.viscosity = 1;
+  c.body = {0.0, 2.0};
+  c.implicit = true;
+  const double h = 2.0 / 16;
+  const double dt = 1.5 * h * h;  // nu dt / h^2 = 1.5: 12x the explicit limit
+  Solver s(c, dt);
+  set_initial(s);
+  for (long k = 0; k < std::lround(12.0 / dt); ++k) s.step(dt);
+  double err = 0;
+  for (int j = 0; j < s.grid().ny(); ++j)
+    for (int i = 0; i < s.grid().nx(); ++i) {
+      const double x = s.grid().x().centre(i);
+      err = std::max(err, std::abs(s.v()(i, j) - x * (2 - x)));
+    }
+  CHECK(err < 1e-10);
+}
