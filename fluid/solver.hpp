@@ -33,11 +33,11 @@ namespace fluid {
 // Faces on a non-periodic boundary carry a prescribed velocity: forcing there is ignored and
 // their f_s is returned as 0.
 struct CouplingIn {
-  std::span<const std::int64_t> solid_u_index, solid_v_index;
+  std::span<const std::int32_t> solid_u_index, solid_v_index;
   std::span<const double> solid_u_alpha, solid_u_velocity, solid_v_alpha, solid_v_velocity;
-  std::span<const std::int64_t> fiber_u_index, fiber_v_index;
+  std::span<const std::int32_t> fiber_u_index, fiber_v_index;
   std::span<const double> fiber_u_force, fiber_v_force;
-  std::span<const std::int64_t> sample_u_index, sample_v_index;
+  std::span<const std::int32_t> sample_u_index, sample_v_index;
 };
 // Output of one step:
 //   solid_*_force: f_s = rho_f alpha (u_s - u~) / dt on the solid's faces, in the input order,

@@ -1,0 +1,175 @@
+// FluidPort implementation: runs the solver step by step, writes fields, probes and wall shear
+// stress, and stops a run that goes unhealthy with a message saying what, where and when.
+#include "program.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "diagnostics.hpp"
+
+namespace fluid {
+
+FluidProgram::FluidProgram(fsi::Runtime& rt)
+    : m_rt(rt),
+      m_cfg(read_config(rt.root().table("fluid"), rt.settings().dt)),
+      m_solver(std::make_unique<Solver>(m_cfg, rt.settings().dt)),
+      m_h5(rt.out_dir() / "fluid.h5", fsi::H5File::Mode::truncate) {
+  set_initial(*m_solver);
+  const Grid& g = m_solver->grid();
+  std::vector<double> xf(g.nx() + 1), yf(g.ny() + 1);
+  for (int i = 0; i <= g.nx(); ++i) xf[i] = g.x().face(i);
+  for (int j = 0; j <= g.ny(); ++j) yf[j] = g.y().face(j);
+  m_h5.create_group("grid");
+  m_h5.write("grid/x_face", xf);
+  m_h5.write("grid/y_face", yf);
+  m_h5.set_attribute("grid", "density", m_cfg.density);
+  m_h5.set_attribute("grid", "viscosity", m_cfg.viscosity);
+  for (Side s : m_cfg.wall_shear) {
+    std::vector<double> pos;
+    wall_shear(*m_solver, s, &pos);
+    m_h5.write(fmt::format("grid/tau_{}_position", kSideNames[s]), pos);
+  }
+  m_xdmf.emplace(rt.out_dir() / "fluid.xdmf", rt.out_dir() / "fluid.h5",
+                 fsi::XdmfRectilinear{"/grid/x_face", xf.size(), "/grid/y_face", yf.size()}, "fluid");
+  if (!m_cfg.probes.empty()) {
+    std::vector<std::string> names;
+    for (const Probe& p : m_cfg.probes) names.push_back(p.name);
+    m_probes.emplace(rt.out_dir() / "fluid_probes.csv", fsi::probe_columns(names, {"ux", "uy", "p"}));
+    m_row.resize(3 * names.size());
+  }
+}
+
+fsi::proto::GridInfo FluidProgram::grid_info() const {
+  const Grid& g = m_solver->grid();
+  fsi::proto::GridInfo gi;
+  gi.nx = g.nx();
+  gi.ny = g.ny();
+  gi.periodic_x = g.x().periodic();
+  gi.periodic_y = g.y().periodic();
+  for (int i = 0; i <= g.nx(); ++i) gi.x_face.push_back(g.x().face(i));
+  for (int j = 0; j <= g.ny(); ++j) gi.y_face.push_back(g.y().face(j));
+  gi.density = m_cfg.density;
+  return gi;
+}
+
+void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::FluidInput& in,
+                           fsi::proto::FluidOutput& out) {
+  CouplingIn c;
+  c.solid_u_index = in.solid_u.index;
+  c.solid_u_alpha = in.solid_u.alpha;
+  c.solid_u_velocity = in.solid_u.velocity;
+  c.solid_v_index = in.solid_v.index;
+  c.solid_v_alpha = in.solid_v.alpha;
+  c.solid_v_velocity = in.solid_v.velocity;
+  c.fiber_u_index = in.force_u.index;
+  c.fiber_u_force = in.force_u.force;
+  c.fiber_v_index = in.force_v.index;
+  c.fiber_v_force = in.force_v.force;
+  c.sample_u_index = in.sample_u;
+  c.sample_v_index = in.sample_v;
+  m_solver->step(s.dt, c, m_out);
+  out.fs_u = m_out.solid_u_force;
+  out.fs_v = m_out.solid_v_force;
+  out.u_sample = m_out.sample_u;
+  out.v_sample = m_out.sample_v;
+  check_health(s.step + 1, s.time + s.dt, s.dt);
+  out.cfl = m_cfl;
+  out.max_div = m_div;
+  out.kinetic_energy = 0;
+}
+
+void FluidProgram::check_health(long step, double t, double dt) {
+  const Extremum c = cfl(*m_solver, dt);
+  m_cfl = c.value;
+  std::string what;
+  if (!std::isfinite(c.value)) {
+    what = "the velocity is not finite (NaN or Inf)";
+  } else if (c.value > m_cfg.cfl_max) {
+    what = fmt::format("CFL number {:.4g} above fluid.health.cfl_max = {:g} in cell ({}, {}) at "
+                       "(x, y) = ({:.6g}, {:.6g}); lower time.dt",
+                       c.value, m_cfg.cfl_max, c.i, c.j, c.x, c.y);
+  } else if (step % m_cfg.health_every == 0) {
+    const Extremum d = max_divergence(*m_solver);
+    m_div = d.value;
+    if (m_div_first < 0) m_div_first = d.value;
+    // Round-off grows slowly with the field; a jump by orders of magnitude is a failure.
+    if (d.value * dt > m_cfg.divergence_max) {
+      what = fmt::format("divergence |div u| dt = {:.3g} above fluid.health.divergence_max = {:g} "
+                         "in cell ({}, {}) at (x, y) = ({:.6g}, {:.6g})",
+                         d.value * dt, m_cfg.divergence_max, d.i, d.j, d.x, d.y);
+    }
+  }
+  if (what.empty()) return;
+  write_fields(step, t);
+  throw fsi::Error(fmt::format("fluid unhealthy at step {}, t = {:.6g}: {} (last state written to {})",
+                               step, t, what, (m_rt.out_dir() / "fluid.h5").string()));
+}
+
+void FluidProgram::write_fields(long step, double t) {
+  if (step == m_written_step) return;
+  m_written_step = step;
+  const Solver& s = *m_solver;
+  const Grid& g = s.grid();
+  const std::string grp = fsi::h5_step_group(step);
+  m_h5.create_group(grp);
+  m_h5.set_attribute(grp, "time", t);
+  const fsi::H5Shape shape{std::size_t(g.ny()), std::size_t(g.nx())};
+  centred_velocity(s, m_w1, m_w2);
+  m_h5.write(grp + "/u", m_w1, shape);
+  m_h5.write(grp + "/v", m_w2, shape);
+  for (int j = 0; j < g.ny(); ++j)
+    for (int i = 0; i < g.nx(); ++i) m_w1[i + std::size_t(g.nx()) * j] = s.p()(i, j);
+  m_h5.write(grp + "/p", m_w1, shape);
+  vorticity(s, m_w1);
+  m_h5.write(grp + "/vorticity", m_w1, shape);
+  // The staggered fields themselves, for exact post-processing.
+  std::vector<double> uf(std::size_t(g.nx() + 1) * g.ny()), vf(std::size_t(g.nx()) * (g.ny() + 1));
+  for (int j = 0; j < g.ny(); ++j)
+    for (int i = 0; i <= g.nx(); ++i) uf[i + std::size_t(g.nx() + 1) * j] = s.u()(i, j);
+  for (int j = 0; j <= g.ny(); ++j)
+    for (int i = 0; i < g.nx(); ++i) vf[i + std::size_t(g.nx()) * j] = s.v()(i, j);
+  m_h5.write(grp + "/u_face", uf, {std::size_t(g.ny()), std::size_t(g.nx() + 1)});
+  m_h5.write(grp + "/v_face", vf, {std::size_t(g.ny() + 1), std::size_t(g.nx())});
+  for (Side side : m_cfg.wall_shear) {
+    m_h5.write(fmt::format("{}/tau_{}", grp, kSideNames[side]), wall_shear(s, side));
+  }
+  std::vector<fsi::XdmfAttribute> at;
+  for (const char* q : {"u", "v", "p", "vorticity"}) {
+    at.push_back({q, fsi::XdmfCenter::cell, grp + "/" + q, 1});
+  }
+  m_xdmf->add_step(t, at);
+}
+
+void FluidProgram::output(long step, double t, bool fields) {
+  if (m_probes) {
+    for (std::size_t k = 0; k < m_cfg.probes.size(); ++k) {
+      const auto& at = m_cfg.probes[k].at;
+      for (int q = 0; q < 3; ++q) m_row[3 * k + q] = sample(*m_solver, q, at[0], at[1]);
+    }
+    m_probes->write(t, m_row);
+  }
+  if (fields) write_fields(step, t);
+}
+
+std::string FluidProgram::status() const {
+  return fmt::format("CFL {:.3f}  div {:.1e}", m_cfl, m_div);
+}
+
+nlohmann::json FluidProgram::report() const {
+  const Timings& tm = m_solver->timings();
+  const double cells = double(m_solver->grid().nx()) * m_solver->grid().ny();
+  const double steps = std::max<long>(tm.steps, 1);
+  const double total = tm.predictor + tm.boundaries + tm.poisson + tm.projection;
+  nlohmann::json j;
+  j["grid"] = {m_solver->grid().nx(), m_solver->grid().ny()};
+  j["steps"] = tm.steps;
+  j["phases"] = {{"predictor", tm.predictor}, {"boundaries", tm.boundaries},
+                 {"poisson", tm.poisson}, {"projection", tm.projection}};
+  j["ns_per_cell_step"] = 1e9 * total / (cells * steps);
+  j["max_divergence"] = max_divergence(*m_solver).value;
+  j["kinetic_energy"] = kinetic_energy(*m_solver);
+  return j;
+}
+
+}  // namespace fluid

@@ -1,0 +1,43 @@
+// The `fluid` program's side of a run: the fluid solver behind the driver's FluidPort, with its
+// output (HDF5 + XDMF fields, probe CSV, wall shear stress), health checks and report.
+#pragma once
+
+#include <memory>
+#include <optional>
+
+#include "driver.hpp"
+#include "h5.hpp"
+#include "probes.hpp"
+#include "solver.hpp"
+#include "xdmf.hpp"
+
+namespace fluid {
+
+class FluidProgram : public fsi::FluidPort {
+ public:
+  explicit FluidProgram(fsi::Runtime& rt);
+  fsi::proto::GridInfo grid_info() const override;
+  void advance(const fsi::proto::StepBegin& s, const fsi::proto::FluidInput& in,
+               fsi::proto::FluidOutput& out) override;
+  void output(long step, double t, bool fields) override;
+  std::string status() const override;
+  nlohmann::json report() const override;
+
+ private:
+  void write_fields(long step, double t);
+  // Health: NaN/Inf, CFL above its limit, divergence growth. Writes the state, then throws.
+  void check_health(long step, double t, double dt);
+
+  fsi::Runtime& m_rt;
+  Config m_cfg;
+  std::unique_ptr<Solver> m_solver;
+  fsi::H5File m_h5;
+  std::optional<fsi::XdmfWriter> m_xdmf;
+  std::optional<fsi::ProbeCsv> m_probes;
+  std::vector<double> m_row, m_w1, m_w2;
+  CouplingOut m_out;
+  double m_cfl = 0, m_div = 0, m_div_first = -1;
+  long m_written_step = -1;
+};
+
+}  // namespace fluid
