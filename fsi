@@ -170,9 +170,9 @@ bench() {
 bench_protocol() {
   local scene=$ROOT/runs/bench-protocol/scene.toml dir=$ROOT/out/bench/protocol
   local f=$(mpirun_flags)
-  mpirun $f -n 1 "$BIN/null_solver" fluid "$scene" : -n 1 "$BIN/null_solver" solid "$scene" \
-    : -n 1 "$BIN/null_solver" fiber "$scene" : -n 1 "$BIN/coupler" "$scene" \
-    --out-dir "$dir" --overwrite
+  local a=("$scene" --out-dir "$dir" --overwrite)
+  mpirun $f -n 1 "$BIN/null_solver" fluid "${a[@]}" : -n 1 "$BIN/null_solver" solid "${a[@]}" \
+    : -n 1 "$BIN/null_solver" fiber "${a[@]}" : -n 1 "$BIN/coupler" "${a[@]}"
   /usr/bin/python3 - "$dir/summary.json" "$ROOT/out/bench/protocol.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))

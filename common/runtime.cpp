@@ -1,6 +1,7 @@
 // MPMD start-up, handshake, links and the error funnel (see runtime.hpp).
 #include "runtime.hpp"
 
+#include <sys/prctl.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -26,6 +27,7 @@ struct Announce {
   std::uint64_t scene_hash;
   std::int32_t needed;
   std::int32_t pad;
+  std::uint64_t options_hash;  // the output options: every program must be given the same
 };
 
 // Wait for a request without spinning the core: test, yield, then sleep with a growing interval
@@ -229,6 +231,10 @@ void check_job(const Runtime& rt, const std::vector<Announce>& all, const RoleSe
       fail("scene mismatch: {} read a scene file with different contents than {} (same path on "
            "every process, same file?)",
            who, rt.name());
+    if (a.options_hash != all[0].options_hash)
+      fail("{} and {} were given different output options (--out, --out-dir, --overwrite); give "
+           "every program of the job the same arguments",
+           who, kRoleNames[all[0].role]);
     if (appnum[a.role] >= 0 && appnum[a.role] != a.appnum)
       fail("role '{}' was launched twice (programs {} and {} of the mpirun line); launch each "
            "program once",
@@ -251,6 +257,9 @@ void check_job(const Runtime& rt, const std::vector<Announce>& all, const RoleSe
 }  // namespace
 
 int run_program(Role role, int argc, char** argv, const std::function<void(Runtime&)>& body) {
+  // Short sleeps of a waiting program must be short: Linux's default timer slack (50 us) would
+  // add its whole length to every wake-up of the polite wait.
+  prctl(PR_SET_TIMERSLACK, 1000UL, 0, 0, 0);
   MPI_Init(&argc, &argv);
   Runtime rt;
   rt.m_role = role;
@@ -285,7 +294,10 @@ int run_program(Role role, int argc, char** argv, const std::function<void(Runti
                 world_rank,
                 rt.m_scene->hash(),
                 rt.m_roles[role] ? 1 : 0,
-                0};
+                0,
+                std::hash<std::string>{}(fmt::format("{}|{}|{}", opts.out_root.string(),
+                                                     opts.out_dir ? opts.out_dir->string() : "-",
+                                                     opts.overwrite))};
     std::vector<Announce> all(static_cast<std::size_t>(world_size));
     MPI_Allgather(&me, sizeof(Announce), MPI_BYTE, all.data(), sizeof(Announce), MPI_BYTE,
                   MPI_COMM_WORLD);
