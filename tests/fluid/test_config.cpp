@@ -1,0 +1,100 @@
+// Bad input in the [fluid] table: each error names the key, the value and the file.
+#include <catch2/catch.hpp>
+
+#include <fstream>
+#include <string>
+
+#include "config.hpp"
+#include "error.hpp"
+#include "scene.hpp"
+
+using Catch::Matchers::Contains;
+
+namespace {
+
+const char* kGood = R"(
+[fluid]
+density = 1.0
+viscosity = 0.01
+[fluid.grid]
+cells = [32, 16]
+size = [2.0, 1.0]
+[fluid.boundary]
+left = { type = "periodic" }
+right = { type = "periodic" }
+bottom = { type = "wall" }
+top = { type = "wall" }
+)";
+
+fluid::Config read(const std::string& text, double dt = 1e-3) {
+  const std::string path = "fluid_config_test.toml";
+  std::ofstream(path) << text;
+  fsi::Scene scene(path);
+  return fluid::read_config(scene.root().table("fluid"), dt);
+}
+
+std::string replace(std::string s, const std::string& from, const std::string& to) {
+  const auto p = s.find(from);
+  REQUIRE(p != std::string::npos);
+  return s.replace(p, from.size(), to);
+}
+
+}  // namespace
+
+TEST_CASE("a good [fluid] table reads", "[fluid][config]") {
+  const fluid::Config c = read(kGood);
+  CHECK(c.x.cells == 32);
+  CHECK(c.y.cells == 16);
+  CHECK(c.bc[fluid::left].type == fluid::BcType::periodic);
+  CHECK(c.bc[fluid::top].type == fluid::BcType::wall);
+}
+
+TEST_CASE("non-positive viscosity or density", "[fluid][config]") {
+  CHECK_THROWS_WITH(read(replace(kGood, "viscosity = 0.01", "viscosity = -1")),
+                    Contains("fluid.viscosity must be > 0, got -1") && Contains("fluid_config_test.toml"));
+  CHECK_THROWS_WITH(read(replace(kGood, "density = 1.0", "density = 0")),
+                    Contains("fluid.density must be > 0, got 0"));
+}
+
+TEST_CASE("grid too small for the stencil", "[fluid][config]") {
+  CHECK_THROWS_WITH(read(replace(kGood, "cells = [32, 16]", "cells = [32, 2]")),
+                    Contains("fluid.grid.cells must be >= 4"));
+}
+
+TEST_CASE("a stretched direction where the transform needs it uniform", "[fluid][config]") {
+  // y stretched and periodic
+  std::string s = replace(kGood, "size = [2.0, 1.0]", "size = [2.0, 1.0]\ny_stretch = 1.5");
+  s = replace(s, "bottom = { type = \"wall\" }", "bottom = { type = \"periodic\" }");
+  s = replace(s, "top = { type = \"wall\" }", "top = { type = \"periodic\" }");
+  CHECK_THROWS_WITH(read(s), Contains("fluid.grid.y_stretch = 1.5 stretches a periodic direction"));
+  // both directions stretched: y by tanh, x by the outlet sponge
+  std::string b = replace(kGood, "size = [2.0, 1.0]", "size = [2.0, 1.0]\ny_stretch = 1.5");
+  b = replace(b, "left = { type = \"periodic\" }", "left = { type = \"inflow\", mean = 1.0 }");
+  b = replace(b, "right = { type = \"periodic\" }", "right = { type = \"outflow\" }");
+  b += "[fluid.sponge]\ncells = 8\nratio = 1.1\n";
+  CHECK_THROWS_WITH(read(b), Contains("needs one uniform direction to transform"));
+}
+
+TEST_CASE("periodic on one side only, inflow on a periodic side", "[fluid][config]") {
+  CHECK_THROWS_WITH(read(replace(kGood, "right = { type = \"periodic\" }", "right = { type = \"wall\" }")),
+                    Contains("fluid.boundary.left is periodic but fluid.boundary.right is wall"));
+  CHECK_THROWS_WITH(
+      read(replace(kGood, "left = { type = \"periodic\" }", "left = { type = \"inflow\", mean = 1.0 }")),
+      Contains("fluid.boundary.left: an inflow cannot face a periodic side"));
+}
+
+TEST_CASE("dt above the explicit stability limit at start", "[fluid][config]") {
+  // h = 1/16, nu = 0.01: limit 1 / (4 nu (256 + 256)) = 0.048828
+  CHECK_THROWS_WITH(read(kGood, 0.1),
+                    Contains("time.dt = 0.1 is above the explicit diffusion stability limit 0.0488281"));
+  // Start-up CFL from a moving wall: u = 10, h = 1/16, dt = 0.01 -> CFL 1.6
+  CHECK_THROWS_WITH(read(replace(kGood, "top = { type = \"wall\" }", "top = { type = \"wall\", velocity = 10.0 }"), 0.01),
+                    Contains("start-up CFL number 1.6 above the limit"));
+  // Implicit diffusion lifts the diffusion limit.
+  CHECK_NOTHROW(read(replace(kGood, "viscosity = 0.01", "viscosity = 0.01\ndiffusion = \"implicit\""), 0.06));
+}
+
+TEST_CASE("unknown keys are errors", "[fluid][config]") {
+  CHECK_THROWS_WITH(read(replace(kGood, "viscosity = 0.01", "viscosity = 0.01\nviscocity = 2")),
+                    Contains("viscocity"));
+}
