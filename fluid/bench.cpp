@@ -1,0 +1,129 @@
+// bench_fluid: time per fluid step split into predictor, boundaries, Poisson and projection, in
+// ns per cell, next to the floor measured in the same run: one bare FFTW transform pair plus
+// tridiagonal solve on the same grid. Writes JSON to --out FILE and prints a table.
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "solver.hpp"
+
+using namespace fluid;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+struct Case {
+  std::string name;
+  Config cfg;
+  double dt;
+};
+
+// The Turek-Hron channel at a given resolution: 2.5 x 0.41, parabolic inflow (mean 1), walls,
+// convective outflow, rho = 1000, mu = 1 (paper Table 2; dt scaled with the cell size).
+Case channel(int nx, int ny) {
+  Config c;
+  c.density = 1000;
+  c.viscosity = 1;
+  c.x = {nx, 2.5, 0.0};
+  c.y = {ny, 0.41, 0.0};
+  c.bc[left].type = BcType::inflow;
+  c.bc[left].mean = 1.0;
+  c.bc[right].type = BcType::outflow;
+  c.bc[bottom].type = c.bc[top].type = BcType::wall;
+  c.initial.type = InitialType::uniform;
+  c.initial.velocity = {1.0, 0.0};
+  return {fmt::format("channel {}x{}", nx, ny), c, 2.5e-5 * 1500.0 / nx};
+}
+
+Case cavity(int n) {
+  Config c;
+  c.density = 1;
+  c.viscosity = 1e-3;
+  c.x = {n, 1.0, 0.0};
+  c.y = {n, 1.0, 0.0};
+  for (auto& b : c.bc) b.type = BcType::wall;
+  c.bc[top].velocity = 1.0;
+  return {fmt::format("cavity {}x{}", n, n), c, 0.4 / n};
+}
+
+template <class F>
+double seconds_per_call(F&& f, double budget) {
+  f();  // warm-up
+  long n = 0;
+  const auto t0 = Clock::now();
+  double el = 0;
+  do {
+    f();
+    ++n;
+    el = std::chrono::duration<double>(Clock::now() - t0).count();
+  } while (el < budget);
+  return el / n;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string out = "fluid.json";
+  double budget = 2.0;
+  for (int k = 1; k < argc; ++k) {
+    if (!std::strcmp(argv[k], "--out") && k + 1 < argc) out = argv[++k];
+    else if (!std::strcmp(argv[k], "--seconds") && k + 1 < argc) budget = std::stod(argv[++k]);
+  }
+  nlohmann::json j;
+  j["grids"] = nlohmann::json::array();
+  fmt::print("{:<20} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>7} {:>7}\n", "grid", "pred ms",
+             "bc ms", "poiss ms", "proj ms", "step ms", "ns/cell", "floor ms", "step/fl", "poi/fl");
+  for (const Case& k : {cavity(256), channel(750, 123), channel(1500, 246)}) {
+    for (bool implicit : {false, true}) {
+      Config c = k.cfg;
+      c.implicit = implicit;
+      c.cfl_max = 1e9;
+      Solver s(c, k.dt);
+      set_initial(s);
+      for (int w = 0; w < 5; ++w) s.step(k.dt);
+      s.reset_timings();
+      const auto t0 = Clock::now();
+      long steps = 0;
+      double el = 0;
+      do {
+        s.step(k.dt);
+        ++steps;
+        el = std::chrono::duration<double>(Clock::now() - t0).count();
+      } while (el < budget);
+      const Timings& tm = s.timings();
+      // The floor: a bare transform pair and tridiagonal sweep on the same Poisson operator.
+      FastSolver& ps = s.poisson();
+      const double floor = seconds_per_call([&] { ps.forward(); ps.tridiagonal(); ps.backward(); }, 0.5 * budget);
+      const double cells = double(s.grid().nx()) * s.grid().ny();
+      const double step = el / steps;
+      const double ms = 1e3 / steps;
+      const double ratio = step / floor, poisson_ratio = tm.poisson / steps / floor;
+      const std::string name = k.name + (implicit ? " CN" : "");
+      fmt::print("{:<20} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.1f} {:>9.3f} {:>7.2f} {:>7.2f}\n",
+                 name, tm.predictor * ms, tm.boundaries * ms, tm.poisson * ms, tm.projection * ms,
+                 step * 1e3, step / cells * 1e9, floor * 1e3, ratio, poisson_ratio);
+      j["grids"].push_back({{"name", name},
+                            {"nx", s.grid().nx()},
+                            {"ny", s.grid().ny()},
+                            {"diffusion", implicit ? "implicit" : "explicit"},
+                            {"steps", steps},
+                            {"ms_per_step",
+                             {{"predictor", tm.predictor * ms},
+                              {"boundaries", tm.boundaries * ms},
+                              {"poisson", tm.poisson * ms},
+                              {"projection", tm.projection * ms},
+                              {"total", step * 1e3}}},
+                            {"ns_per_cell_step", step / cells * 1e9},
+                            {"poisson_floor_ms", floor * 1e3},
+                            {"step_to_floor_ratio", ratio},
+                            {"poisson_to_floor_ratio", poisson_ratio}});
+    }
+  }
+  std::ofstream(out) << j.dump(2) << "\n";
+  fmt::print("written {}\n", out);
+  return 0;
+}
