@@ -1,0 +1,148 @@
+// Contact geometry: closest point on a master surface, signed gap, normal, ray-casting inside
+// test; bounding boxes skip far pairs.
+#include "contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace solid {
+
+bool inside_surface(const Mesh& mesh, const std::vector<double>& x, double px, double py) {
+  // Crossings of the ray from p towards +x with every surface edge (half-open in y).
+  bool inside = false;
+  for (const auto& e : mesh.surface) {
+    const double ax = x[2 * e[0]], ay = x[2 * e[0] + 1];
+    const double bx = x[2 * e[1]], by = x[2 * e[1] + 1];
+    if ((ay > py) != (by > py)) {
+      const double xc = ax + (py - ay) * (bx - ax) / (by - ay);
+      if (xc > px) inside = !inside;
+    }
+  }
+  return inside;
+}
+
+void ContactSet::setup(const std::vector<const Mesh*>& meshes, const std::vector<BodyKind>& kinds,
+                       const std::vector<ContactPair>& pairs,
+                       const std::vector<ContactPlane>& planes) {
+  m_surfaces.clear();
+  m_slots.clear();
+  m_planes = planes;
+  for (const Mesh* m : meshes) {
+    Surface s;
+    s.mesh = m;
+    for (const auto& e : m->surface) s.nodes.insert(s.nodes.end(), e.begin(), e.end());
+    std::sort(s.nodes.begin(), s.nodes.end());
+    s.nodes.erase(std::unique(s.nodes.begin(), s.nodes.end()), s.nodes.end());
+    m_surfaces.push_back(std::move(s));
+  }
+  auto add = [&](int slave, int master) {
+    if (kinds[slave] != BodyKind::elastic) return;  // rigid nodes cannot move
+    for (int n : m_surfaces[slave].nodes) {
+      ContactSlot c;
+      c.slave_body = slave;
+      c.slave_node = n;
+      c.master_body = master;
+      m_slots.push_back(c);
+    }
+  };
+  for (const auto& p : pairs) {
+    add(p.slave, p.master);
+    if (p.two_way) add(p.master, p.slave);
+  }
+  for (std::size_t k = 0; k < planes.size(); ++k)
+    for (int b : planes[k].bodies) {
+      if (kinds[b] != BodyKind::elastic) continue;
+      for (int n : m_surfaces[b].nodes) {
+        ContactSlot c;
+        c.slave_body = b;
+        c.slave_node = n;
+        c.plane = static_cast<int>(k);
+        m_slots.push_back(c);
+      }
+    }
+}
+
+void ContactSet::detect(const std::vector<const std::vector<double>*>& x) {
+  // Bounding boxes of every surface (xmin, ymin, xmax, ymax).
+  std::vector<std::array<double, 4>> boxes(m_surfaces.size());
+  for (std::size_t b = 0; b < m_surfaces.size(); ++b) {
+    auto& box = boxes[b];
+    box = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+           -std::numeric_limits<double>::max(), -std::numeric_limits<double>::max()};
+    for (int n : m_surfaces[b].nodes) {
+      box[0] = std::min(box[0], (*x[b])[2 * n]);
+      box[1] = std::min(box[1], (*x[b])[2 * n + 1]);
+      box[2] = std::max(box[2], (*x[b])[2 * n]);
+      box[3] = std::max(box[3], (*x[b])[2 * n + 1]);
+    }
+  }
+  for (auto& s : m_slots) detect_slot(s, x, boxes);
+}
+
+void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector<double>*>& x,
+                             const std::vector<std::array<double, 4>>& boxes) const {
+  const double px = (*x[s.slave_body])[2 * s.slave_node];
+  const double py = (*x[s.slave_body])[2 * s.slave_node + 1];
+  if (s.plane >= 0) {
+    const auto& pl = m_planes[s.plane];
+    s.normal = pl.normal;
+    s.gap = (px - pl.point[0]) * pl.normal[0] + (py - pl.point[1]) * pl.normal[1];
+    s.m0 = s.m1 = -1;
+    s.xi = 0;
+    return;
+  }
+  const auto& box = boxes[s.master_body];
+  const double dx = std::max({box[0] - px, 0.0, px - box[2]});
+  const double dy = std::max({box[1] - py, 0.0, py - box[3]});
+  if ((dx > 0 || dy > 0) && !s.active) {
+    // Outside the master's box: a lower bound of the gap is enough to stay inactive.
+    s.gap = std::hypot(dx, dy);
+    s.m0 = s.m1 = -1;
+    return;
+  }
+  const Mesh& mesh = *m_surfaces[s.master_body].mesh;
+  const std::vector<double>& xm = *x[s.master_body];
+  double best = std::numeric_limits<double>::max();
+  int best_edge = -1;
+  double best_xi = 0;
+  for (std::size_t k = 0; k < mesh.surface.size(); ++k) {
+    const auto& e = mesh.surface[k];
+    const double ax = xm[2 * e[0]], ay = xm[2 * e[0] + 1];
+    const double ex = xm[2 * e[1]] - ax, ey = xm[2 * e[1] + 1] - ay;
+    const double l2 = ex * ex + ey * ey;
+    double xi = ((px - ax) * ex + (py - ay) * ey) / l2;
+    xi = std::clamp(xi, 0.0, 1.0);
+    const double qx = ax + xi * ex - px, qy = ay + xi * ey - py;
+    const double d2 = qx * qx + qy * qy;
+    // Ties (a vertex shared by two edges) prefer the edge whose interior holds the projection.
+    const bool interior = xi > 0 && xi < 1;
+    if (d2 < best * (1 - 1e-12) || (d2 <= best * (1 + 1e-12) && interior)) {
+      best = d2;
+      best_edge = static_cast<int>(k);
+      best_xi = xi;
+    }
+  }
+  const auto& e = mesh.surface[best_edge];
+  const double ax = xm[2 * e[0]], ay = xm[2 * e[0] + 1];
+  const double ex = xm[2 * e[1]] - ax, ey = xm[2 * e[1] + 1] - ay;
+  const double le = std::hypot(ex, ey);
+  const double dist = std::sqrt(best);
+  const bool vertex = best_xi <= 0 || best_xi >= 1;
+  if (vertex && dist > 1e-9 * le) {
+    const int v = best_xi <= 0 ? e[0] : e[1];
+    const double sign = inside_surface(mesh, xm, px, py) ? -1.0 : 1.0;
+    s.m0 = v;
+    s.m1 = -1;
+    s.xi = 0;
+    s.normal = {sign * (px - xm[2 * v]) / dist, sign * (py - xm[2 * v + 1]) / dist};
+    s.gap = sign * dist;
+    return;
+  }
+  s.m0 = e[0];
+  s.m1 = e[1];
+  s.xi = best_xi;
+  s.normal = {ey / le, -ex / le};
+  s.gap = (px - ax - best_xi * ex) * s.normal[0] + (py - ay - best_xi * ey) * s.normal[1];
+}
+
+}  // namespace solid

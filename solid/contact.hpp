@@ -1,0 +1,61 @@
+// Frictionless node-to-segment contact (paper Eq. 3-4, Wriggers 2006): every surface node of a
+// slave body is a candidate against the surface of a master body (elastic or rigid) or a rigid
+// plane. The signed gap g = (x_s - x_p) . n, with x_p the closest point of the master surface and
+// n its outward normal, is negative inside the master (inside is decided by ray casting, so deep
+// penetration is caught too). Active constraints g = 0 are enforced by Lagrange multipliers
+// lambda >= 0 (solver.cpp); this file only does the geometry.
+#pragma once
+
+#include <array>
+#include <limits>
+#include <vector>
+
+#include "model.hpp"
+
+namespace solid {
+
+// One candidate constraint and its state.
+struct ContactSlot {
+  int slave_body = -1, slave_node = -1;
+  int master_body = -1;  // -1: a plane
+  int plane = -1;
+  // From the last detection: the gap, the master feature (segment m0 -> m1 at parameter xi, or
+  // the vertex m0 when m1 == -1) and the normal n, so that dg/dx_s = n,
+  // dg/dx_m0 = -(1 - xi) n, dg/dx_m1 = -xi n.
+  double gap = std::numeric_limits<double>::infinity();
+  int m0 = -1, m1 = -1;
+  double xi = 0;
+  Vec2 normal{0, 0};
+  // Active-set state carried across Newton iterations and steps.
+  bool active = false;
+  double lambda = 0;  // multiplier, > 0 pushes the bodies apart
+};
+
+class ContactSet {
+ public:
+  // Builds the slots: the surface nodes of each pair's slave against its master (and back when
+  // two-way), and of each plane's bodies against the plane.
+  void setup(const std::vector<const Mesh*>& meshes, const std::vector<BodyKind>& kinds,
+             const std::vector<ContactPair>& pairs, const std::vector<ContactPlane>& planes);
+  bool empty() const { return m_slots.empty(); }
+  // Updates gap, feature and normal of every slot from current positions (one vector per body).
+  void detect(const std::vector<const std::vector<double>*>& x);
+  std::vector<ContactSlot>& slots() { return m_slots; }
+  const std::vector<ContactSlot>& slots() const { return m_slots; }
+
+ private:
+  struct Surface {
+    const Mesh* mesh = nullptr;
+    std::vector<int> nodes;  // nodes on the surface
+  };
+  void detect_slot(ContactSlot& s, const std::vector<const std::vector<double>*>& x,
+                   const std::vector<std::array<double, 4>>& boxes) const;
+  std::vector<Surface> m_surfaces;
+  std::vector<ContactPlane> m_planes;
+  std::vector<ContactSlot> m_slots;
+};
+
+// True when point p is inside the closed surface loops (edges a -> b) of a mesh at positions x.
+bool inside_surface(const Mesh& mesh, const std::vector<double>& x, double px, double py);
+
+}  // namespace solid

@@ -1,0 +1,142 @@
+// The solid solver: total-Lagrangian linear triangles for every elastic body, Newmark
+// (beta = 1/4, gamma = 1/2) with Newton-Raphson each step or load-stepped statics, constraints
+// (fixed, prescribed, periodic), gravity and external nodal loads, frictionless node-to-segment
+// contact with Lagrange multipliers, rigid bodies with prescribed motion, eigenmodes.
+// One sparse system holds every elastic body (contact couples them); its symbolic analysis is
+// done once. Not thread-safe; no MPI.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseCholesky>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "contact.hpp"
+#include "element.hpp"
+#include "model.hpp"
+
+namespace solid {
+
+// What one step (or one load step) did.
+struct StepReport {
+  int iterations = 0;                // Newton iterations (linear solves)
+  std::vector<double> residuals;     // ||R|| at each iteration, first one before any solve
+  double tolerance = 0;              // the residual target of this step
+  bool converged = false;
+  int active_contacts = 0;
+  double assembly_seconds = 0, factor_seconds = 0, solve_seconds = 0;
+};
+
+// Eigenmodes of K phi = omega^2 M phi about the reference state (paper Eq. 28).
+struct Modes {
+  std::vector<double> omega;                  // angular frequencies, ascending [rad / time]
+  std::vector<std::vector<std::vector<double>>> shapes;  // [mode][body] nodal (x0, y0, ...), M-normalised
+};
+
+class Solver {
+ public:
+  // Validates the model (throws fsi::InputError for bad input), numbers the equations, builds
+  // the sparse pattern and its symbolic factorisation, and sets the initial state (reference
+  // configuration, initial velocities).
+  explicit Solver(Model model);
+  ~Solver();
+
+  const Model& model() const { return m_model; }
+  int num_bodies() const { return static_cast<int>(m_bodies.size()); }
+  int body_index(const std::string& name) const;  // -1 when absent
+  int num_equations() const { return m_neq; }
+  double time() const { return m_time; }
+  long step() const { return m_step; }
+
+  // One Newmark step of size dt. external[b] (may be null or empty per body) holds nodal forces
+  // on body b, layout (f0x, f0y, f1x, ...), force ON the solid, held over the step; they are
+  // added to gravity and the scene's loads at t + dt. Throws fsi::Error when Newton fails, an
+  // element inverts (det F <= 0) or a value is not finite; the message names body, element or
+  // node, step and time.
+  StepReport advance(double dt, const std::vector<std::vector<double>>* external = nullptr);
+
+  // Static analysis: the loads and prescribed displacements scaled by k / load_steps,
+  // k = 1 ... load_steps, each solved by Newton. Returns the report of every load step.
+  std::vector<StepReport> solve_static();
+  // One static equilibrium at load factor `factor` from the current state.
+  StepReport solve_static_step(double factor);
+
+  // Current state of body b, layout (x0, y0, x1, y1, ...).
+  const std::vector<double>& positions(int b) const;
+  const std::vector<double>& velocities(int b) const;
+  std::vector<double> displacements(int b) const;
+  const Mesh& mesh(int b) const;
+  BodyKind kind(int b) const;
+
+  // Sets the velocity of body b (elastic: free dofs only, e.g. an initial mode shape).
+  void set_velocity(int b, const std::vector<double>& v);
+  // Sets the positions of body b (elastic; prescribed dofs keep their values).
+  void set_positions(int b, const std::vector<double>& x);
+
+  // Energies of the current state: kinetic 1/2 v^T M v (inertial density rho_s - rho_f),
+  // strain sum A0 W, and the potential of gravity and the constant scene loads -F^T u.
+  double kinetic_energy() const;
+  double strain_energy() const;
+  double load_potential() const;
+
+  // Per-element det F, von Mises stress (plane-strain Cauchy stress) of body b.
+  std::vector<double> element_det_f(int b) const;
+  std::vector<double> element_von_mises(int b) const;
+
+  // Contact: the multiplier force on each surface node of body b (layout as positions; force ON
+  // body b) and the normal contact pressure per node (force / tributary current length).
+  std::vector<double> contact_forces(int b) const;
+  std::vector<double> contact_pressure(int b) const;
+  Vec2 total_contact_force(int b) const;
+  double min_contact_gap() const;  // smallest signed gap over every contact candidate (+inf if none)
+
+  // Support reaction on the prescribed nodes of boundary `name` of body b: the force the
+  // support exerts on the body (sum over its constrained nodes).
+  Vec2 reaction(int b, const std::string& boundary) const;
+
+  // Lowest `count` eigenpairs of the linearised problem about the reference configuration
+  // (stiffness at the reference state, constraints applied), by Spectra shift-invert about
+  // `shift` (rad^2 / time^2). Needs a non-zero inertial density on every elastic element.
+  Modes modes(int count, double shift = 0) const;
+
+  // Nodal forces of body b from the scene's loads (gravity, tractions, point loads) at load
+  // factor or time t; used by tests and diagnostics.
+  std::vector<double> scene_loads(int b, double t) const;
+
+ private:
+  struct Body;
+  void setup_body(int index);
+  void number_equations();
+  void build_pattern();
+  void update_prescribed(double t);
+  void update_rigid(double t);
+  // Assembles R (free equations) and, when with_matrix, K_eff = K_T + c0 M into m_matrix.
+  // Returns the first inverted element as (body, element) or (-1, -1).
+  std::pair<int, int> assemble(double c0, double dt, bool with_matrix, double load_factor,
+                               const std::vector<std::vector<double>>* external);
+  StepReport newton(double c0, double dt, double load_factor,
+                    const std::vector<std::vector<double>>* external, const std::string& when);
+  void factorize(const std::string& when);
+  [[noreturn]] void fail_health(const std::string& what, int body, int element,
+                                const std::string& when) const;
+  void check_finite(const std::string& when) const;
+  void check_inverted(const std::string& when) const;
+
+  Model m_model;
+  std::vector<std::unique_ptr<Body>> m_bodies;
+  int m_neq = 0;
+  double m_time = 0;
+  long m_step = 0;
+  double m_force_scale = 0;  // norm of |F_ext| + |Q| + |inertia| from the last assembly
+  double m_roundoff_scale = 0;  // the same with the terms of c0 M u: the round-off floor
+  Eigen::SparseMatrix<double> m_matrix;  // lower triangle of K_eff on the free equations
+  Eigen::VectorXd m_residual;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> m_ldlt;
+  ContactSet m_contact;
+  double m_contact_force_factor = 1;  // physical contact force / multiplier (1/2 in Newmark)
+};
+
+}  // namespace solid
