@@ -17,8 +17,16 @@ namespace {
 
 // Gmsh keeps global state: initialise for one read, always finalise.
 struct GmshSession {
-  GmshSession() {
-    gmsh::initialize(0, nullptr, false);
+  explicit GmshSession(const GmshOptions& options) {
+    std::vector<std::string> args{"gmsh"};
+    for (const auto& [name, value] : options.parameters) {
+      args.push_back("-setnumber");
+      args.push_back(name);
+      args.push_back(fmt::format("{:.17g}", value));
+    }
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    gmsh::initialize(static_cast<int>(argv.size()), argv.data(), false);
     gmsh::option::setNumber("General.Terminal", 0);
     gmsh::option::setNumber("General.Verbosity", 1);
   }
@@ -54,7 +62,7 @@ Mesh read_gmsh(const std::filesystem::path& file, const GmshOptions& options,
           "{}: mesh file '{}' is not a Gmsh mesh (no $MeshFormat header)", key, name));
   }
 
-  GmshSession session;
+  GmshSession session(options);
   try {
     gmsh::open(name);
     if (ext == ".geo") {

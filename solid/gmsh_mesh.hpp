@@ -5,6 +5,8 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "mesh.hpp"
 
@@ -13,6 +15,8 @@ namespace solid {
 struct GmshOptions {
   double size_factor = 1;  // Mesh.MeshSizeFactor for .geo files
   int refine = 0;          // uniform refinements (each splits every triangle in four)
+  // Values for the .geo file's DefineConstant[] parameters (as gmsh -setnumber name value).
+  std::vector<std::pair<std::string, double>> parameters;
 };
 
 // Throws fsi::InputError when the file is missing, is not a Gmsh .geo/.msh file, or holds no
