@@ -13,8 +13,8 @@ namespace fiber::test {
 inline FiberSpec make_fiber(double length, int segments, double density, double bending, Vec2 position = {0, 0},
                             double angle = 0) {
   FiberSpec f;
-  f.name = "f";
-  f.key = "fiber.fiber[0]";
+  f.name = std::string("f");
+  f.key = std::string("fiber.fiber[0]");
   f.length = length;
   f.segments = segments;
   f.density = density;

@@ -40,8 +40,8 @@ TEST_CASE("translating and fixed fibers: the driver carries the applied loads", 
   FiberSpec a = make_fiber(1.0, 8, 1.5, 0.0, {0, 0}, 0.0);
   a.motion.kind = MotionKind::fixed;
   FiberSpec b = make_fiber(0.5, 4, 1.0, 0.0, {0, 1}, std::numbers::pi / 2);
-  b.name = "b";
-  b.key = "fiber.fiber[1]";
+  b.name = std::string("b");
+  b.key = std::string("fiber.fiber[1]");
   b.motion.kind = MotionKind::translating;
   b.motion.velocity = {0.2, -0.1};
   c.fibers = {a, b};
@@ -81,8 +81,8 @@ TEST_CASE("many fibers: a row of identical clamped fibers moves identically", "[
   Config c;
   for (int k = 0; k < 16; ++k) {
     FiberSpec f = make_fiber(0.125, 62, 0.1, 1e-4, {k / 16.0, 0}, std::numbers::pi / 2);
-    f.name = "g" + std::to_string(k);
-    f.key = "fiber.fiber[0]";
+    f.name = fmt::format("g{}", k);
+    f.key = std::string("fiber.fiber[0]");
     f.root.kind = EndKind::clamped;
     c.fibers.push_back(f);
   }
@@ -106,8 +106,8 @@ TEST_CASE("many fibers: a row of identical clamped fibers moves identically", "[
 TEST_CASE("library input checks: overlap, sizes, the bending limit", "[fiber][input]") {
   FiberSpec a = make_fiber(1.0, 10, 1.0, 1.0);
   FiberSpec b = make_fiber(1.0, 10, 1.0, 1.0, {0.5, 0.001}, 0.0);
-  b.name = "b";
-  b.key = "fiber.fiber[1]";
+  b.name = std::string("b");
+  b.key = std::string("fiber.fiber[1]");
   Config c;
   c.fibers = {a, b};
   c.repulsion = {true, 1e-6, 0.01};

@@ -49,8 +49,8 @@ TEST_CASE("two fibers pushed towards each other are held apart by the repulsion"
   a.root.kind = EndKind::clamped;
   a.damping = 0.5;
   FiberSpec b = a;
-  b.name = "b";
-  b.key = "fiber.fiber[1]";
+  b.name = std::string("b");
+  b.key = std::string("fiber.fiber[1]");
   b.position = {0, 0.05};
   c.fibers = {a, b};
   c.repulsion = {true, k, cutoff};
