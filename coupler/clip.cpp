@@ -1,0 +1,71 @@
+// Triangle-box clipping and polygon moments (see clip.hpp).
+#include "clip.hpp"
+
+namespace coupler {
+
+namespace {
+
+// Clip polygon `in` (n vertices) against the half-plane s·(p_axis) <= s·c, i.e. keep
+// p_axis <= c when s = +1 and p_axis >= c when s = −1. A vertex exactly on the line is kept;
+// an edge crossing the line contributes the crossing point, found by linear interpolation along
+// the crossing coordinate so that it lies exactly on the line.
+int clip_half_plane(const Vec2* in, int n, bool is_x, double c, double s, Vec2* out) {
+  int m = 0;
+  for (int k = 0; k < n; ++k) {
+    const Vec2 a = in[k];
+    const Vec2 b = in[(k + 1) % n];
+    const double da = s * ((is_x ? a.x : a.y) - c);  // <= 0: inside
+    const double db = s * ((is_x ? b.x : b.y) - c);
+    if (da <= 0) out[m++] = a;
+    if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
+      const double t = da / (da - db);
+      Vec2 p{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
+      if (is_x) p.x = c;
+      else p.y = c;
+      out[m++] = p;
+    }
+  }
+  return m;
+}
+
+}  // namespace
+
+int clip_triangle_box(const Vec2 tri[3], double x0, double x1, double y0, double y1, Vec2 out[7]) {
+  // A triangle clipped by four half-planes has at most 3 + 4 = 7 vertices.
+  Vec2 a[8], b[8];
+  int n = clip_half_plane(tri, 3, true, x0, -1.0, a);
+  if (n == 0) return 0;
+  n = clip_half_plane(a, n, true, x1, 1.0, b);
+  if (n == 0) return 0;
+  n = clip_half_plane(b, n, false, y0, -1.0, a);
+  if (n == 0) return 0;
+  n = clip_half_plane(a, n, false, y1, 1.0, b);
+  for (int k = 0; k < n; ++k) out[k] = b[k];
+  return n;
+}
+
+PolygonMoments polygon_moments(const Vec2* p, int n) {
+  // Coordinates relative to the first vertex keep the cross products small (less cancellation).
+  double a2 = 0, cx = 0, cy = 0;
+  const Vec2 o = p[0];
+  for (int k = 1; k + 1 < n; ++k) {
+    const double x1 = p[k].x - o.x, y1 = p[k].y - o.y;
+    const double x2 = p[k + 1].x - o.x, y2 = p[k + 1].y - o.y;
+    const double cr = x1 * y2 - x2 * y1;
+    a2 += cr;
+    cx += (x1 + x2) * cr;
+    cy += (y1 + y2) * cr;
+  }
+  PolygonMoments m{0.5 * a2, o};
+  if (a2 != 0) m.centroid = {o.x + cx / (3 * a2), o.y + cy / (3 * a2)};
+  return m;
+}
+
+void barycentric(const Vec2 t[3], Vec2 q, double n[3]) {
+  const double det = (t[1].x - t[0].x) * (t[2].y - t[0].y) - (t[2].x - t[0].x) * (t[1].y - t[0].y);
+  n[1] = ((q.x - t[0].x) * (t[2].y - t[0].y) - (t[2].x - t[0].x) * (q.y - t[0].y)) / det;
+  n[2] = ((t[1].x - t[0].x) * (q.y - t[0].y) - (q.x - t[0].x) * (t[1].y - t[0].y)) / det;
+  n[0] = 1.0 - n[1] - n[2];
+}
+
+}  // namespace coupler

@@ -1,0 +1,213 @@
+// Volume fractions, mean solid velocities and the nodal reaction (see immersed.hpp).
+#include "immersed.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "clip.hpp"
+#include "error.hpp"
+
+namespace coupler {
+
+namespace {
+
+// Box edges at the cell centres c(k−1), k = 0..n, of a direction with faces f[0..nc]: the
+// control volumes of the faces of that direction. Outside the grid, a periodic direction wraps;
+// a bounded one mirrors (those boxes belong to boundary faces, which never take part).
+std::vector<double> centre_edges(const std::vector<double>& f, bool periodic, int n) {
+  const int nc = static_cast<int>(f.size()) - 1;
+  auto centre = [&](int k) {
+    if (k < 0) return periodic ? 0.5 * (f[nc - 1] + f[nc]) - (f[nc] - f[0]) : f[0] - 0.5 * (f[1] - f[0]);
+    if (k >= nc) return f[nc] + 0.5 * (f[nc] - f[nc - 1]);
+    return 0.5 * (f[k] + f[k + 1]);
+  };
+  std::vector<double> e(static_cast<std::size_t>(n + 1));
+  for (int k = 0; k <= n; ++k) e[k] = centre(k - 1);
+  return e;
+}
+
+}  // namespace
+
+FaceBoxes FaceBoxes::u_faces(const proto::GridInfo& g) {
+  FaceBoxes b;
+  const bool px = g.periodic_x != 0;
+  b.ni = px ? g.nx : g.nx + 1;
+  b.ex = centre_edges(g.x_face, px, b.ni);
+  b.i_lo = px ? 0 : 1;
+  b.i_hi = g.nx;
+  b.nj = g.ny;
+  b.ey = g.y_face;
+  b.j_lo = 0;
+  b.j_hi = g.ny;
+  b.period_x = px ? g.x_face.back() - g.x_face.front() : 0;
+  b.period_y = g.periodic_y ? g.y_face.back() - g.y_face.front() : 0;
+  return b;
+}
+
+FaceBoxes FaceBoxes::v_faces(const proto::GridInfo& g) {
+  FaceBoxes b;
+  const bool py = g.periodic_y != 0;
+  b.ni = g.nx;
+  b.ex = g.x_face;
+  b.i_lo = 0;
+  b.i_hi = g.nx;
+  b.nj = py ? g.ny : g.ny + 1;
+  b.ey = centre_edges(g.y_face, py, b.nj);
+  b.j_lo = py ? 0 : 1;
+  b.j_hi = g.ny;
+  b.period_x = g.periodic_x ? g.x_face.back() - g.x_face.front() : 0;
+  b.period_y = py ? g.y_face.back() - g.y_face.front() : 0;
+  return b;
+}
+
+ImmersedSolid::ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshes& meshes)
+    : m_meshes(meshes), m_ub(FaceBoxes::u_faces(grid)), m_vb(FaceBoxes::v_faces(grid)) {
+  m_slot.assign(static_cast<std::size_t>(std::max(m_ub.ni * m_ub.nj, m_vb.ni * m_vb.nj)), -1);
+}
+
+// Every triangle of body b at positions x, against every box its bounding box meets (and its
+// periodic images).
+void ImmersedSolid::clip_body(const FaceBoxes& boxes, int b, const std::vector<double>& x,
+                              Raw& raw) const {
+  const auto& tri = m_meshes.bodies[b].tri;
+  const double sx[3] = {0.0, -boxes.period_x, boxes.period_x};
+  const double sy[3] = {0.0, -boxes.period_y, boxes.period_y};
+  const int nsx = boxes.period_x > 0 ? 3 : 1, nsy = boxes.period_y > 0 ? 3 : 1;
+  const double xlo = boxes.ex[boxes.i_lo], xhi = boxes.ex[boxes.i_hi];
+  const double ylo = boxes.ey[boxes.j_lo], yhi = boxes.ey[boxes.j_hi];
+  Vec2 poly[7], t[3];
+  for (std::size_t e = 0; e + 2 < tri.size(); e += 3) {
+    const int a[3] = {tri[e], tri[e + 1], tri[e + 2]};
+    Vec2 p[3];
+    for (int k = 0; k < 3; ++k) p[k] = {x[2 * a[k]], x[2 * a[k] + 1]};
+    const double bx0 = std::min({p[0].x, p[1].x, p[2].x}), bx1 = std::max({p[0].x, p[1].x, p[2].x});
+    const double by0 = std::min({p[0].y, p[1].y, p[2].y}), by1 = std::max({p[0].y, p[1].y, p[2].y});
+    for (int qy = 0; qy < nsy; ++qy) {
+      for (int qx = 0; qx < nsx; ++qx) {
+        const double x0 = bx0 + sx[qx], x1 = bx1 + sx[qx], y0 = by0 + sy[qy], y1 = by1 + sy[qy];
+        if (x1 <= xlo || x0 >= xhi || y1 <= ylo || y0 >= yhi) continue;
+        for (int k = 0; k < 3; ++k) t[k] = {p[k].x + sx[qx], p[k].y + sy[qy]};
+        const int i0 = std::max<int>(
+            boxes.i_lo, std::upper_bound(boxes.ex.begin(), boxes.ex.end(), x0) - boxes.ex.begin() - 1);
+        const int i1 = std::min<int>(
+            boxes.i_hi - 1, std::lower_bound(boxes.ex.begin(), boxes.ex.end(), x1) - boxes.ex.begin() - 1);
+        const int j0 = std::max<int>(
+            boxes.j_lo, std::upper_bound(boxes.ey.begin(), boxes.ey.end(), y0) - boxes.ey.begin() - 1);
+        const int j1 = std::min<int>(
+            boxes.j_hi - 1, std::lower_bound(boxes.ey.begin(), boxes.ey.end(), y1) - boxes.ey.begin() - 1);
+        for (int j = j0; j <= j1; ++j) {
+          for (int i = i0; i <= i1; ++i) {
+            const int n = clip_triangle_box(t, boxes.ex[i], boxes.ex[i + 1], boxes.ey[j],
+                                            boxes.ey[j + 1], poly);
+            if (n < 3) continue;
+            const PolygonMoments m = polygon_moments(poly, n);
+            const double area = std::abs(m.area);
+            if (area == 0) continue;
+            double N[3];
+            barycentric(t, m.centroid, N);
+            for (int k = 0; k < 3; ++k) {
+              raw.face.push_back(i + boxes.ni * j);
+              raw.body.push_back(b);
+              raw.node.push_back(a[k]);
+              raw.weight.push_back(area * N[k]);
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
+// Sort the pieces by face (a counting sort over the touched faces only).
+void ImmersedSolid::gather(const FaceBoxes& boxes, const Raw& fixed, const Raw& moving, Pieces& p) {
+  (void)boxes;
+  p.face.clear();
+  for (const Raw* r : {&fixed, &moving})
+    for (const std::int32_t f : r->face)
+      if (m_slot[f] < 0) m_slot[f] = 0, p.face.push_back(f);
+  std::sort(p.face.begin(), p.face.end());
+  const std::size_t nf = p.face.size();
+  for (std::size_t k = 0; k < nf; ++k) m_slot[p.face[k]] = static_cast<std::int32_t>(k);
+  p.begin.assign(nf + 1, 0);
+  for (const Raw* r : {&fixed, &moving})
+    for (const std::int32_t f : r->face) ++p.begin[m_slot[f] + 1];
+  for (std::size_t k = 0; k < nf; ++k) p.begin[k + 1] += p.begin[k];
+  const std::size_t ne = static_cast<std::size_t>(p.begin[nf]);
+  p.body.resize(ne), p.node.resize(ne), p.weight.resize(ne);
+  m_count.assign(p.begin.begin(), p.begin.end() - 1);
+  for (const Raw* r : {&fixed, &moving}) {
+    for (std::size_t e = 0; e < r->face.size(); ++e) {
+      const std::int32_t at = m_count[m_slot[r->face[e]]]++;
+      p.body[at] = r->body[e], p.node[at] = r->node[e], p.weight[at] = r->weight[e];
+    }
+  }
+  p.area.assign(nf, 0.0);
+  p.total_area = 0;
+  for (std::size_t k = 0; k < nf; ++k) {
+    for (std::int32_t e = p.begin[k]; e < p.begin[k + 1]; ++e) p.area[k] += p.weight[e];
+    p.total_area += p.area[k];
+    m_slot[p.face[k]] = -1;
+  }
+}
+
+void ImmersedSolid::fill(const FaceBoxes& boxes, const Pieces& p, const proto::SolidState& state,
+                         int component, proto::FaceSolid& out) const {
+  const std::size_t nf = p.face.size();
+  out.index = p.face;
+  out.alpha.resize(nf);
+  out.velocity.resize(nf);
+  for (std::size_t k = 0; k < nf; ++k) {
+    const int i = p.face[k] % boxes.ni, j = p.face[k] / boxes.ni;
+    out.alpha[k] = std::min(1.0, p.area[k] / boxes.volume(i, j));
+    double sum = 0;
+    for (std::int32_t e = p.begin[k]; e < p.begin[k + 1]; ++e)
+      sum += p.weight[e] * state.v[p.body[e]][2 * p.node[e] + component];
+    out.velocity[k] = sum / p.area[k];
+  }
+}
+
+void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, proto::FaceSolid& v) {
+  const auto& bodies = m_meshes.bodies;
+  if (state.x.size() != bodies.size() || state.v.size() != bodies.size())
+    fsi::fail("solid state has {} bodies, the meshes {}", state.x.size(), bodies.size());
+  if (!m_fixed_done) {
+    for (int b = 0; b < static_cast<int>(bodies.size()); ++b) {
+      if (bodies[b].kind != 1) continue;
+      clip_body(m_ub, b, state.x[b], m_fixed_u);
+      clip_body(m_vb, b, state.x[b], m_fixed_v);
+    }
+    m_fixed_done = true;
+  }
+  m_raw_u.clear();
+  m_raw_v.clear();
+  for (int b = 0; b < static_cast<int>(bodies.size()); ++b) {
+    if (bodies[b].kind == 1) continue;
+    clip_body(m_ub, b, state.x[b], m_raw_u);
+    clip_body(m_vb, b, state.x[b], m_raw_v);
+  }
+  gather(m_ub, m_fixed_u, m_raw_u, m_u);
+  gather(m_vb, m_fixed_v, m_raw_v, m_v);
+  fill(m_ub, m_u, state, 0, u);
+  fill(m_vb, m_v, state, 1, v);
+}
+
+void ImmersedSolid::reaction(const std::vector<double>& fs_u, const std::vector<double>& fs_v,
+                             std::vector<std::vector<double>>& force) const {
+  const auto& bodies = m_meshes.bodies;
+  force.resize(bodies.size());
+  for (std::size_t b = 0; b < bodies.size(); ++b) force[b].assign(bodies[b].x_ref.size(), 0.0);
+  auto add = [&](const FaceBoxes& boxes, const Pieces& p, const std::vector<double>& fs, int c) {
+    if (fs.size() != p.face.size())
+      fsi::fail("protocol error: {} forcing values for {} solid faces", fs.size(), p.face.size());
+    for (std::size_t k = 0; k < p.face.size(); ++k) {
+      const int i = p.face[k] % boxes.ni, j = p.face[k] / boxes.ni;
+      const double coef = -fs[k] * boxes.volume(i, j) / p.area[k];
+      for (std::int32_t e = p.begin[k]; e < p.begin[k + 1]; ++e)
+        force[p.body[e]][2 * p.node[e] + c] += coef * p.weight[e];
+    }
+  };
+  add(m_ub, m_u, fs_u, 0);
+  add(m_vb, m_v, fs_v, 1);
+}
+
+}  // namespace coupler

@@ -1,0 +1,83 @@
+// The immersed solid method's transfers (paper Sec. 3.2.1, DESIGN.md §4.4): exact volume
+// fractions and mean solid velocities on the staggered control volumes a body touches, and the
+// exact nodal reaction of the fluid's forcing. Cost grows with the bodies' footprint, not the grid.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "protocol.hpp"
+
+namespace coupler {
+
+namespace proto = fsi::proto;
+
+// One family of staggered faces (u or v) seen as control-volume boxes: face (i, j) owns
+// [ex[i], ex[i+1]] × [ey[j], ey[j+1]]. Only faces with an unknown velocity take part: a face on a
+// non-periodic boundary (a wall, an inflow, an outflow) carries a boundary value, not a forced one.
+struct FaceBoxes {
+  std::vector<double> ex, ey;
+  int ni = 0, nj = 0;            // faces along x and y; flat index i + ni*j
+  int i_lo = 0, i_hi = 0;        // faces [i_lo, i_hi) × [j_lo, j_hi) are unknowns
+  int j_lo = 0, j_hi = 0;
+  double period_x = 0, period_y = 0;  // domain lengths when periodic, else 0
+
+  // u-face (i, j) at (x_face[i], y_centre[j]): box [x_centre[i-1], x_centre[i]] × [y_face[j], y_face[j+1]].
+  static FaceBoxes u_faces(const proto::GridInfo& g);
+  // v-face (i, j) at (x_centre[i], y_face[j]): box [x_face[i], x_face[i+1]] × [y_centre[j-1], y_centre[j]].
+  static FaceBoxes v_faces(const proto::GridInfo& g);
+  double volume(int i, int j) const { return (ex[i + 1] - ex[i]) * (ey[j + 1] - ey[j]); }
+};
+
+class ImmersedSolid {
+ public:
+  ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshes& meshes);
+
+  // Step 2 of DESIGN.md §3, from the bodies' current state: for every face whose control volume
+  // V meets a body, α = min(1, Σ_bodies |V ∩ body| / |V|) and the mean solid velocity component
+  //   ū_s = Σ_T Σ_a u_a ∫_{V∩T} N_a dA / Σ_T |V ∩ T|,
+  // exact because N_a is linear on each triangle T: ∫_P N_a dA = |P| N_a(centroid of P).
+  // Rigid fixed bodies are clipped once and reused.
+  void update(const proto::SolidState& state, proto::FaceSolid& u, proto::FaceSolid& v);
+
+  // Step 6: the nodal force on every body, the exact reaction of f_s (force per unit volume on
+  // the fluid, on the faces of the last update, in their order):
+  //   F_a = − Σ_V f_s(V) |V| ∫_{V∩body} N_a dA / Σ_bodies |V ∩ body|,
+  // so Σ_a F_a = − Σ_V f_s(V) |V| to round-off. `force` gets one vector (2 per node) per body.
+  void reaction(const std::vector<double>& fs_u, const std::vector<double>& fs_v,
+                std::vector<std::vector<double>>& force) const;
+
+  // The solid area seen by each family in the last update (Σ_V α|V| without the cap), for checks.
+  double area_u() const { return m_u.total_area; }
+  double area_v() const { return m_v.total_area; }
+
+ private:
+  // The clipped pieces of one family: per touched face (sorted by index), its entries
+  // (body, node, ∫N dA) in [begin[k], begin[k+1]).
+  struct Pieces {
+    std::vector<std::int32_t> face;
+    std::vector<double> area;            // Σ |V ∩ T| of the face
+    std::vector<std::int32_t> begin;
+    std::vector<std::int32_t> body, node;
+    std::vector<double> weight;
+    double total_area = 0;
+  };
+  struct Raw {  // unsorted entries while clipping
+    std::vector<std::int32_t> face, body, node;
+    std::vector<double> weight;
+    void clear() { face.clear(), body.clear(), node.clear(), weight.clear(); }
+  };
+  void clip_body(const FaceBoxes& boxes, int b, const std::vector<double>& x, Raw& raw) const;
+  void gather(const FaceBoxes& boxes, const Raw& fixed, const Raw& moving, Pieces& p);
+  void fill(const FaceBoxes& boxes, const Pieces& p, const proto::SolidState& state, int component,
+            proto::FaceSolid& out) const;
+
+  const proto::BodyMeshes& m_meshes;
+  FaceBoxes m_ub, m_vb;
+  Raw m_fixed_u, m_fixed_v, m_raw_u, m_raw_v;  // rigid fixed bodies' pieces, clipped once
+  bool m_fixed_done = false;
+  Pieces m_u, m_v;
+  std::vector<std::int32_t> m_slot, m_count;   // per face of a family: scratch for gather()
+};
+
+}  // namespace coupler
