@@ -11,6 +11,7 @@
 #include <numeric>
 
 #include "error.hpp"
+#include "solver_body.hpp"
 
 namespace solid {
 
@@ -35,42 +36,6 @@ double TimeFunction::operator()(double t) const {
   }
   return 1.0;
 }
-
-// A prescribed dof: u = value(t) from a constraint, or that of another prescribed dof (a
-// periodic image of a prescribed node).
-struct Prescribed {
-  int dof = -1;
-  int constraint = -1;  // index into spec.constraints, or -1
-  int component = 0;
-  int follow = -1;  // dof whose displacement this one copies
-};
-
-struct Solver::Body {
-  BodySpec spec;
-  int index = 0;
-  std::vector<ElementGeometry> geo;
-  std::vector<int> material;       // per element
-  std::vector<double> rho_inertia;  // per element: rho_s - rho_f
-  std::vector<double> mass_row;     // per dof: row sum of M (zero: massless dof)
-  std::vector<int> eq;              // per dof: equation, -1 when prescribed
-  std::vector<Prescribed> prescribed;
-  std::vector<std::array<int, 36>> kmap;  // per element: index into the matrix values
-  std::vector<double> X;                  // reference positions
-  std::vector<double> u, v, ma;           // state: displacements, velocities, M a (Newmark)
-  std::vector<double> x;                  // positions X + u, kept in step with u
-  std::vector<double> u_old, v_old;       // state at the start of the step
-  std::vector<double> f_ext, q, r;        // last assembly: loads, internal force, residual
-  std::vector<double> contact;            // contact force on the nodes (physical)
-  std::vector<double> det_f;              // per element, last assembly
-  // Loads: constant part (gravity) and per-load nodal coefficients.
-  std::vector<double> gravity;
-  std::vector<std::vector<std::pair<int, double>>> load_dofs;  // per spec.loads entry
-  double min_edge = 0;
-  bool is_elastic() const { return spec.kind == BodyKind::elastic; }
-  void sync_positions() {
-    for (std::size_t d = 0; d < x.size(); ++d) x[d] = X[d] + u[d];
-  }
-};
 
 Solver::~Solver() = default;
 
@@ -541,12 +506,68 @@ void Solver::check_inverted(const std::string& when) const {
   }
 }
 
-// Newton-Raphson on R(x) + B^T lambda = 0 with the active contact constraints g(x) = 0:
-//   K_eff dx = R + B^T lambda,  B dx = -g,
-// solved through the factorised K_eff: y0 = K^-1 R, Y = K^-1 B^T, (B Y) lambda = -g - B y0,
-// dx = y0 + Y lambda. A slot is active when it penetrates (g < -tol) or stays active with
-// lambda > 0; converged when ||R + B^T lambda|| <= tol, the active set no longer changes and
-// every active gap is within the contact tolerance.
+// The linearised contact conditions of one Newton iteration as a complementarity problem:
+//   w = S lambda + q >= 0,  lambda >= 0,  lambda . w = 0,
+// with S = B K^-1 B^T (symmetric, positive semi-definite) and q = g + B K^-1 R the gaps after the
+// step without contact. Equivalent to min 1/2 l^T S l + q^T l over l >= 0, solved exactly by the
+// Lawson-Hanson active-set method; S + eps I (eps = 1e-12 max diag S) makes a constraint that
+// two-way pairs repeat harmless. `tol` is the accepted negative gap.
+namespace {
+
+Eigen::VectorXd solve_contact_lcp(const Eigen::MatrixXd& S0, const Eigen::VectorXd& q, double tol) {
+  const int m = static_cast<int>(q.size());
+  Eigen::MatrixXd S = S0;
+  S.diagonal().array() += 1e-12 * S0.diagonal().cwiseAbs().maxCoeff();
+  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(m);
+  std::vector<bool> passive(m, false);
+  for (int outer = 0; outer < 4 * m + 10; ++outer) {
+    const Eigen::VectorXd w = S * lambda + q;
+    int j = -1;
+    for (int i = 0; i < m; ++i)
+      if (!passive[i] && w[i] < -tol && (j < 0 || w[i] < w[j])) j = i;
+    if (j < 0) break;
+    passive[j] = true;
+    for (int inner = 0; inner < 4 * m + 10; ++inner) {
+      std::vector<int> p;
+      for (int i = 0; i < m; ++i)
+        if (passive[i]) p.push_back(i);
+      const int np = static_cast<int>(p.size());
+      Eigen::MatrixXd Spp(np, np);
+      Eigen::VectorXd rhs(np);
+      for (int a = 0; a < np; ++a) {
+        rhs[a] = -q[p[a]];
+        for (int b = 0; b < np; ++b) Spp(a, b) = S(p[a], p[b]);
+      }
+      const Eigen::VectorXd z = Spp.ldlt().solve(rhs);
+      if (z.minCoeff() > 0) {
+        for (int a = 0; a < np; ++a) lambda[p[a]] = z[a];
+        break;
+      }
+      // Step from lambda towards z until the first passive multiplier reaches zero.
+      double alpha = 1;
+      for (int a = 0; a < np; ++a)
+        if (z[a] <= 0) alpha = std::min(alpha, lambda[p[a]] / (lambda[p[a]] - z[a]));
+      for (int a = 0; a < np; ++a) {
+        lambda[p[a]] += alpha * (z[a] - lambda[p[a]]);
+        if (lambda[p[a]] <= 1e-300 || (z[a] <= 0 && lambda[p[a]] <= 1e-14 * std::abs(z[a]))) {
+          lambda[p[a]] = 0;
+          passive[p[a]] = false;
+        }
+      }
+    }
+  }
+  return lambda;
+}
+
+}  // namespace
+
+// Newton-Raphson on R(x) + B^T lambda = 0 with the contact conditions g(x) >= 0, lambda >= 0,
+// lambda g = 0 (paper Eq. 3-5). Each iteration linearises both:
+//   K_eff dx = R + B^T lambda,  g + B dx >= 0,  lambda >= 0,  lambda (g + B dx) = 0,
+// solved through the factorised K_eff: y0 = K^-1 R, Y = K^-1 B^T, the complementarity problem
+// for lambda with S = B Y, q = g + B y0 (solve_contact_lcp), then dx = y0 + Y lambda. The active
+// set is the lambda > 0 of the last iteration. Converged when ||R + B^T lambda|| <= tol, no slot
+// penetrates and every active gap is closed, both within the contact tolerance.
 StepReport Solver::newton(double c0, double dt, double time_or_factor,
                           const std::vector<std::vector<double>>* external,
                           const std::string& when) {
@@ -587,29 +608,30 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
       fsi::fail("solid: non-finite residual at {}", when);
     }
 
-    // Contact: geometry at the current iterate, then the active set.
-    std::vector<int> active;
-    bool changed = false;
+    // Contact: geometry at the current iterate; the slots that are active (lambda > 0) or
+    // within reach (gap below one element edge) become candidates of this iteration's
+    // complementarity problem.
+    std::vector<int> cand;
     double worst_gap = 0;
     Eigen::VectorXd R = m_residual;
+    int n_active = 0;
     if (!m_contact.empty()) {
       m_contact.detect(xs);
       for (auto& s : slots) {
-        const bool keep = s.active && s.lambda > 0;
-        const bool now = s.gap < -gap_tol || keep;
-        if (now != s.active) changed = true;
-        if (!now) s.lambda = 0;
-        s.active = now;
-        if (now) {
-          active.push_back(static_cast<int>(&s - slots.data()));
+        if (s.active) {
           worst_gap = std::max(worst_gap, std::abs(s.gap));
+          n_active++;
+        } else {
+          worst_gap = std::max(worst_gap, -s.gap);
         }
+        if (s.active || s.gap < m_bodies[s.slave_body]->min_edge)
+          cand.push_back(static_cast<int>(&s - slots.data()));
       }
     }
-    // Rows of B (dg/dx on the free equations) for the active slots.
-    std::vector<std::vector<std::pair<int, double>>> rows(active.size());
-    for (std::size_t k = 0; k < active.size(); ++k) {
-      const ContactSlot& s = slots[active[k]];
+    // Rows of B = dg/dx on the free equations.
+    std::vector<std::vector<std::pair<int, double>>> rows(cand.size());
+    for (std::size_t k = 0; k < cand.size(); ++k) {
+      const ContactSlot& s = slots[cand[k]];
       auto add = [&](int body, int node, double w) {
         const Body& B = *m_bodies[body];
         for (int i = 0; i < 2; ++i) {
@@ -622,16 +644,18 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
         add(s.master_body, s.m0, s.m1 >= 0 ? -(1 - s.xi) : -1.0);
         if (s.m1 >= 0) add(s.master_body, s.m1, -s.xi);
       }
-      for (const auto& [e, w] : rows[k]) R[e] += s.lambda * w;
+      if (s.active)
+        for (const auto& [e, w] : rows[k]) R[e] += s.lambda * w;
     }
     const double rn = R.norm();
     rep.residuals.push_back(rn);
     rep.tolerance = st.newton_tolerance * m_force_scale;
-    rep.active_contacts = static_cast<int>(active.size());
-    // Converged: below tolerance, or stalled at round-off after at least one solve.
+    rep.active_contacts = n_active;
+    // Converged: below tolerance, or stalled at round-off after at least one solve; no
+    // penetration and every active constraint closed.
     const bool small = rn <= rep.tolerance;
     const bool stalled = it > 0 && rn > 0.5 * previous && rn <= 1e-13 * m_roundoff_scale;
-    if ((small || stalled) && !changed && worst_gap <= gap_tol) {
+    if ((small || stalled) && worst_gap <= gap_tol) {
       rep.converged = true;
       break;
     }
@@ -643,24 +667,27 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
     rep.factor_seconds += seconds_since(t0);
     t0 = clock::now();
     dx = m_ldlt.solve(m_residual);
-    if (!active.empty()) {
-      const int na = static_cast<int>(active.size());
-      Eigen::MatrixXd Bt = Eigen::MatrixXd::Zero(m_neq, na);
-      Eigen::VectorXd rhs(na);
-      for (int k = 0; k < na; ++k) {
+    if (!cand.empty()) {
+      const int nc = static_cast<int>(cand.size());
+      Eigen::MatrixXd Bt = Eigen::MatrixXd::Zero(m_neq, nc);
+      Eigen::VectorXd q(nc);
+      for (int k = 0; k < nc; ++k) {
         for (const auto& [e, w] : rows[k]) Bt(e, k) += w;
-        rhs[k] = -slots[active[k]].gap;
+        q[k] = slots[cand[k]].gap;
       }
       const Eigen::MatrixXd Y = m_ldlt.solve(Bt);
       const Eigen::MatrixXd S = Bt.transpose() * Y;
-      rhs -= Bt.transpose() * dx;
-      // Minimum-norm multipliers: two-way pairs may repeat a constraint.
-      Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
-      cod.setThreshold(1e-12);
-      cod.compute(S);
-      const Eigen::VectorXd lambda = cod.solve(rhs);
+      q += Bt.transpose() * dx;
+      const Eigen::VectorXd lambda = solve_contact_lcp(S, q, gap_tol);
       dx += Y * lambda;
-      for (int k = 0; k < na; ++k) slots[active[k]].lambda = lambda[k];
+      for (auto& s : slots) {
+        s.active = false;
+        s.lambda = 0;
+      }
+      for (int k = 0; k < nc; ++k) {
+        slots[cand[k]].lambda = lambda[k];
+        slots[cand[k]].active = lambda[k] > 0;
+      }
     }
     rep.solve_seconds += seconds_since(t0);
     for (auto& bp : m_bodies) {

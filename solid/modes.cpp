@@ -1,0 +1,106 @@
+// Eigenmodes (paper Eq. 28): |K - omega^2 M| = 0 about the reference configuration, with K the
+// linear stiffness (tangent at u = 0) and M the mass of the inertial density rho_s - rho_f, on
+// the free equations. Lowest modes by Spectra's shift-invert Lanczos about a shift sigma.
+#include <Spectra/MatOp/SparseSymMatProd.h>
+#include <Spectra/SymGEigsShiftSolver.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "error.hpp"
+#include "solver_body.hpp"
+
+namespace solid {
+
+namespace {
+
+// y = (K - sigma M)^-1 x through one sparse LDL^T (lower triangles stored).
+class ShiftInvertOp {
+ public:
+  using Scalar = double;
+  ShiftInvertOp(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M)
+      : m_K(K), m_M(M) {}
+  Eigen::Index rows() const { return m_K.rows(); }
+  Eigen::Index cols() const { return m_K.cols(); }
+  void set_shift(double sigma) {
+    m_ldlt.compute(m_K - sigma * m_M);
+    if (m_ldlt.info() != Eigen::Success)
+      fsi::fail("solid: modes: K - sigma M could not be factorised for sigma = {}", sigma);
+  }
+  void perform_op(const double* x_in, double* y_out) const {
+    Eigen::Map<const Eigen::VectorXd> x(x_in, m_K.rows());
+    Eigen::Map<Eigen::VectorXd> y(y_out, m_K.rows());
+    y = m_ldlt.solve(x);
+  }
+
+ private:
+  const Eigen::SparseMatrix<double>& m_K;
+  const Eigen::SparseMatrix<double>& m_M;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> m_ldlt;
+};
+
+}  // namespace
+
+Modes Solver::modes(int count, double shift) const {
+  if (count < 1) fsi::fail("solid: modes: need at least one mode, got {}", count);
+  Eigen::SparseMatrix<double> K = m_matrix, M = m_matrix;
+  std::fill_n(K.valuePtr(), K.nonZeros(), 0.0);
+  std::fill_n(M.valuePtr(), M.nonZeros(), 0.0);
+  const bool lumped = m_model.settings.lumped_mass;
+  for (const auto& bp : m_bodies) {
+    const Body& B = *bp;
+    if (!B.is_elastic()) continue;
+    const double zero[2] = {0, 0};
+    for (int e = 0; e < B.spec.mesh.num_triangles(); ++e) {
+      if (!(B.rho_inertia[e] > 0))
+        fsi::fail("solid: modes need a positive inertial density rho_s - rho_f; body '{}' element "
+                  "{} has {}", B.spec.name, e, B.rho_inertia[e]);
+      double fe[6], ke[36], J;
+      element_internal(B.spec.materials[B.material[e]], B.geo[e], zero, zero, zero, fe, ke, &J);
+      double me[3][3];
+      element_mass(B.geo[e].area, lumped, me);
+      const auto& map = B.kmap[e];
+      for (int r = 0; r < 6; ++r)
+        for (int c = 0; c < 6; ++c) {
+          const int k = map[6 * r + c];
+          if (k < 0) continue;
+          K.valuePtr()[k] += ke[6 * r + c];
+          if (r % 2 == c % 2) M.valuePtr()[k] += B.rho_inertia[e] * me[r / 2][c / 2];
+        }
+    }
+  }
+  const int n = m_neq;
+  const int nev = std::min(count, n - 1);
+  const int ncv = std::min(n, std::max(2 * nev + 1, nev + 20));
+  ShiftInvertOp op(K, M);
+  Spectra::SparseSymMatProd<double, Eigen::Lower> bop(M);
+  Spectra::SymGEigsShiftSolver<ShiftInvertOp, Spectra::SparseSymMatProd<double, Eigen::Lower>,
+                               Spectra::GEigsMode::ShiftInvert>
+      solver(op, bop, nev, ncv, shift);
+  solver.init();
+  solver.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
+  if (solver.info() != Spectra::CompInfo::Successful)
+    fsi::fail("solid: modes: the eigensolver did not converge for {} modes", nev);
+  const Eigen::VectorXd lam = solver.eigenvalues();
+  const Eigen::MatrixXd vec = solver.eigenvectors();
+  std::vector<int> order(lam.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return lam[a] < lam[b]; });
+  Modes out;
+  for (int k : order) {
+    out.omega.push_back(std::sqrt(std::max(lam[k], 0.0)));
+    std::vector<std::vector<double>> shape;
+    for (const auto& bp : m_bodies) {
+      std::vector<double> s(bp->X.size(), 0.0);
+      if (bp->is_elastic())
+        for (std::size_t d = 0; d < s.size(); ++d)
+          if (bp->eq[d] >= 0) s[d] = vec(bp->eq[d], k);
+      shape.push_back(std::move(s));
+    }
+    out.shapes.push_back(std::move(shape));
+  }
+  return out;
+}
+
+}  // namespace solid

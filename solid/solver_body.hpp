@@ -1,0 +1,49 @@
+// Internal: the per-body data of the Solver (equation map, element data, state vectors),
+// shared by the solver's translation units (solver.cpp, modes.cpp). Not part of the API.
+#pragma once
+
+#include <array>
+#include <utility>
+#include <vector>
+
+#include "solver.hpp"
+
+namespace solid {
+
+// A prescribed dof: u = value(t) from a constraint, or that of another prescribed dof (a
+// periodic image of a prescribed node).
+struct Prescribed {
+  int dof = -1;
+  int constraint = -1;  // index into spec.constraints, or -1
+  int component = 0;
+  int follow = -1;  // dof whose displacement this one copies
+};
+
+struct Solver::Body {
+  BodySpec spec;
+  int index = 0;
+  std::vector<ElementGeometry> geo;
+  std::vector<int> material;       // per element
+  std::vector<double> rho_inertia;  // per element: rho_s - rho_f
+  std::vector<double> mass_row;     // per dof: row sum of M (zero: massless dof)
+  std::vector<int> eq;              // per dof: equation, -1 when prescribed
+  std::vector<Prescribed> prescribed;
+  std::vector<std::array<int, 36>> kmap;  // per element: index into the matrix values
+  std::vector<double> X;                  // reference positions
+  std::vector<double> u, v, ma;           // state: displacements, velocities, M a (Newmark)
+  std::vector<double> x;                  // positions X + u, kept in step with u
+  std::vector<double> u_old, v_old;       // state at the start of the step
+  std::vector<double> f_ext, q, r;        // last assembly: loads, internal force, residual
+  std::vector<double> contact;            // contact force on the nodes (physical)
+  std::vector<double> det_f;              // per element, last assembly
+  // Loads: constant part (gravity) and per-load nodal coefficients.
+  std::vector<double> gravity;
+  std::vector<std::vector<std::pair<int, double>>> load_dofs;  // per spec.loads entry
+  double min_edge = 0;
+  bool is_elastic() const { return spec.kind == BodyKind::elastic; }
+  void sync_positions() {
+    for (std::size_t d = 0; d < x.size(); ++d) x[d] = X[d] + u[d];
+  }
+};
+
+}  // namespace solid

@@ -1,0 +1,143 @@
+// Contact: two blocks pressed together (no penetration, contact force = applied load, action =
+// reaction, either body as slave), a block on a rigid body, a block dropped on a rigid plane
+// (no penetration, no energy growth, it bounces).
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "solver.hpp"
+
+using namespace solid;
+
+namespace {
+
+Constraint fixed(const std::string& b, bool x = true, bool y = true) {
+  Constraint c;
+  c.boundary = b;
+  c.x = x;
+  c.y = y;
+  return c;
+}
+
+// Bottom block [0, 1] x [0, 0.5] held at its base; top block [0.2, 0.8] x [0.5, 0.9] with a
+// different mesh, its top pushed down by `press`.
+Model two_blocks(double press, int slave, bool two_way, MaterialModel mm) {
+  Model model;
+  model.settings.analysis = Analysis::statics;
+  model.settings.load_steps = 4;
+  model.settings.newton_tolerance = 1e-12;
+  BodySpec a;
+  a.name = "base";
+  a.mesh = rectangle_mesh(0, 0, 1, 0.5, 10, 5, Diagonals::criss_cross);
+  a.materials = {Material::from_young(mm, 1e4, 0.3, 1)};
+  a.constraints = {fixed("bottom")};
+  BodySpec b;
+  b.name = "punch";
+  b.mesh = rectangle_mesh(0.2, 0.5, 0.6, 0.4, 7, 5, Diagonals::criss_cross);
+  b.materials = {Material::from_young(mm, 2e4, 0.3, 1)};
+  Constraint top = fixed("top");
+  top.type = Constraint::Type::displacement;
+  top.displacement = {0, -press};
+  b.constraints = {top};
+  model.bodies = {a, b};
+  ContactPair p;
+  p.slave = slave;
+  p.master = 1 - slave;
+  p.two_way = two_way;
+  model.contacts = {p};
+  return model;
+}
+
+}  // namespace
+
+TEST_CASE("two blocks pressed together: no penetration, contact force = applied load", "[contact]") {
+  for (MaterialModel mm : {MaterialModel::saint_venant_kirchhoff, MaterialModel::neo_hookean})
+    for (int slave : {0, 1})
+      for (bool two_way : {false, true}) {
+        INFO(material_model_name(mm) << " slave body " << slave << " two-way " << two_way);
+        Solver s(two_blocks(0.02, slave, two_way, mm));
+        const auto reps = s.solve_static();
+        for (const auto& r : reps) CHECK(r.converged);
+        const Vec2 load = s.reaction(1, "top");      // what pushes the punch down
+        const Vec2 fc_punch = s.total_contact_force(1);
+        const Vec2 fc_base = s.total_contact_force(0);
+        const Vec2 support = s.reaction(0, "bottom");
+        CHECK(load[1] < 0);
+        CHECK(reps.back().active_contacts > 0);
+        // Contact force on the punch balances the applied load; the base gets the opposite.
+        CHECK(std::abs(fc_punch[1] + load[1]) <= 1e-8 * std::abs(load[1]));
+        CHECK(std::abs(fc_base[1] - load[1]) <= 1e-8 * std::abs(load[1]));
+        CHECK(std::abs(support[1] + load[1]) <= 1e-8 * std::abs(load[1]));
+        // No penetration beyond 1e-8 of the block size (0.5).
+        CHECK(s.min_contact_gap() >= -1e-8 * 0.5);
+      }
+}
+
+TEST_CASE("either body as slave gives the same contact force", "[contact]") {
+  Solver a(two_blocks(0.02, 0, false, MaterialModel::neo_hookean));
+  Solver b(two_blocks(0.02, 1, false, MaterialModel::neo_hookean));
+  a.solve_static();
+  b.solve_static();
+  const double fa = a.total_contact_force(1)[1], fb = b.total_contact_force(1)[1];
+  INFO("punch on base " << fa << ", base on punch " << fb);
+  // Node-to-segment with different slave sides differs by the discretisation of the contact
+  // surface, not by more.
+  CHECK(fa == Approx(fb).epsilon(0.05));
+}
+
+TEST_CASE("a block pressed onto a fixed rigid body", "[contact][rigid]") {
+  Model model = two_blocks(0.02, 1, false, MaterialModel::saint_venant_kirchhoff);
+  model.bodies[0].kind = BodyKind::rigid;
+  model.bodies[0].materials.clear();
+  Solver s(model);
+  s.solve_static();
+  const Vec2 load = s.reaction(1, "top");
+  CHECK(std::abs(s.total_contact_force(1)[1] + load[1]) <= 1e-8 * std::abs(load[1]));
+  // The punch bottom sits on y = 0.5 within the contact tolerance.
+  const auto& x = s.positions(1);
+  for (int n : s.mesh(1).boundary_nodes("bottom")) CHECK(std::abs(x[2 * n + 1] - 0.5) <= 1e-8);
+  // The whole bottom is pressed: roughly the stiffness times the strain, E 0.02 / 0.4 * 0.6.
+  CHECK(-load[1] > 0.5 * 2e4 * 0.05 * 0.6);
+}
+
+TEST_CASE("a block dropped on a rigid plane bounces without penetration or energy growth",
+          "[contact][dynamic]") {
+  Model model;
+  model.settings.gravity = {0, -10};
+  model.settings.newton_tolerance = 1e-12;
+  BodySpec b;
+  b.name = "block";
+  b.mesh = rectangle_mesh(0, 0.05, 0.4, 0.2, 8, 4, Diagonals::criss_cross);
+  b.materials = {Material::from_young(MaterialModel::neo_hookean, 2e4, 0.3, 10)};
+  model.bodies = {b};
+  ContactPlane plane;
+  plane.point = {0, 0};
+  plane.normal = {0, 1};
+  plane.bodies = {0};
+  model.planes = {plane};
+  Solver s(model);
+  const double e0 = s.kinetic_energy() + s.strain_energy() + s.load_potential();
+  double worst_gap = 0, max_energy = e0, min_vy = 0, max_vy_after = -1e9;
+  bool touched = false;
+  const double mass = 10 * 0.4 * 0.2;
+  for (int k = 0; k < 300; ++k) {
+    const auto rep = s.advance(1e-3);
+    worst_gap = std::min(worst_gap, s.min_contact_gap());
+    const double e = s.kinetic_energy() + s.strain_energy() + s.load_potential();
+    max_energy = std::max(max_energy, e);
+    double vy = 0;
+    const auto& v = s.velocities(0);
+    for (std::size_t d = 1; d < v.size(); d += 2) vy += v[d] / (v.size() / 2);
+    if (rep.active_contacts > 0) touched = true;
+    if (!touched) min_vy = std::min(min_vy, vy);
+    else max_vy_after = std::max(max_vy_after, vy);
+  }
+  INFO("impact speed " << -min_vy << ", largest upward speed after " << max_vy_after
+                       << ", energy " << e0 << " -> max " << max_energy << ", gap " << worst_gap);
+  CHECK(touched);
+  CHECK(worst_gap >= -1e-8 * 0.4);
+  // Energy scale: the weight times the drop height (the reference state has zero energy).
+  const double scale = mass * 10 * 0.05;
+  CHECK(max_energy <= e0 + 1e-9 * scale);
+  CHECK(max_vy_after > 0.1 * -min_vy);  // it comes back up
+}
