@@ -1,6 +1,9 @@
 // serve(): the solver side of the step sequence (see driver.hpp and common/PROTOCOL.md).
 #include "driver.hpp"
 
+#include "progress.hpp"
+#include "summary.hpp"
+
 #include <cmath>
 #include <fstream>
 
@@ -15,23 +18,10 @@ bool is_output_step(const CommonSettings& s, long n) {
 }
 
 void write_summary(const Runtime& rt, const nlohmann::json& summary) {
-  const auto path = rt.out_dir() / "summary.json";
-  const auto tmp = rt.out_dir() / "summary.json.tmp";
-  {
-    std::ofstream out(tmp);
-    out << summary.dump(2) << "\n";
-    if (!out) fail("cannot write {}", tmp.string());
-  }
-  std::filesystem::rename(tmp, path);
+  write_file_atomically(rt.out_dir() / "summary.json", summary.dump(2) + "\n");
 }
 
 namespace {
-
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path);
-  out << text;
-  if (!out) fail("cannot write {}", path.string());
-}
 
 nlohmann::json base_summary(const Runtime& rt, long steps) {
   nlohmann::json j;
@@ -47,30 +37,23 @@ nlohmann::json base_summary(const Runtime& rt, long steps) {
 template <class Port, class Advance>
 void run_alone(Runtime& rt, Port& port, Advance advance) {
   const auto& s = rt.settings();
-  write_text(rt.out_dir() / "scene.effective.toml", rt.scene().effective_toml());
+  write_file_atomically(rt.out_dir() / "scene.effective.toml", rt.scene().effective_toml());
   port.output(0, 0.0, is_output_step(s, 0));
-  const double t0 = rt.wall_seconds();
-  double last_print = t0;
+  Progress::Options po;
+  po.every_steps = s.progress_every;
+  Progress progress(fmt::format("[{}]", rt.name()), s.steps, step_time(s, s.steps), po);
   for (long n = 0; n < s.steps; ++n) {
     rt.check_fault(n);
     const proto::StepBegin sb{n, step_time(s, n), s.dt, proto::Action::step};
     advance(sb);
     port.output(n + 1, step_time(s, n + 1), is_output_step(s, n + 1));
-    const double now = rt.wall_seconds();
-    if (now - last_print > 2.0 || n + 1 == s.steps) {
-      const double rate = (n + 1) / std::max(now - t0, 1e-9);
-      std::fprintf(stderr, "[%s] step %ld/%ld  t=%.6g  dt=%.3g  %s  %.1f steps/s  ETA %.0f s\n",
-                   rt.name(), n + 1, s.steps, step_time(s, n + 1), s.dt, port.status().c_str(), rate,
-                   (s.steps - n - 1) / rate);
-      last_print = now;
-    }
+    progress.update(n + 1, step_time(s, n + 1), s.dt, [&] { return port.status(); });
   }
   nlohmann::json j = base_summary(rt, s.steps);
   j["wall_time"][rt.name()] = rt.wall_seconds();
   j[rt.name()] = port.report();
   write_summary(rt, j);
-  std::fprintf(stderr, "[%s] done: %ld steps in %.2f s; output in %s\n", rt.name(), s.steps,
-               rt.wall_seconds(), rt.out_dir().string().c_str());
+  progress.finish(s.steps, step_time(s, s.steps), fmt::format("output in {}", rt.out_dir().string()));
 }
 
 // Coupled: follow the coupler's step_begin messages until it says stop.

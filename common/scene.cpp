@@ -364,6 +364,31 @@ std::vector<double> SceneTable::numbers(std::string_view key, std::vector<double
   return numbers(key);
 }
 
+std::vector<std::string> SceneTable::strings(std::string_view key) const {
+  const Value* v = static_cast<const Value*>(lookup(key));
+  if (!v) missing(key, "key");
+  if (!v->is_array())
+    fail(key, fmt::format("must be an array of strings, got {} ({})", show(*v), type_name(*v)));
+  std::vector<std::string> out;
+  for (const auto& e : v->as_array()) {
+    if (!e.is_string())
+      fail(key, fmt::format("must be an array of strings, got {} with a {} element", show(*v),
+                            type_name(e)));
+    out.push_back(e.as_string().str);
+  }
+  return out;
+}
+std::vector<std::string> SceneTable::strings(std::string_view key,
+                                             std::vector<std::string> fallback) const {
+  if (!lookup(key)) {
+    std::vector<std::string> items;
+    for (const auto& x : fallback) items.push_back(toml::format(Value(x)));
+    record(key, fmt::format("[{}]", fmt::join(items, ", ")));
+    return fallback;
+  }
+  return strings(key);
+}
+
 std::array<double, 2> SceneTable::vec2(std::string_view key) const {
   const auto v = numbers(key);
   if (v.size() != 2) fail(key, fmt::format("must have 2 components, got {}", v.size()));

@@ -45,6 +45,8 @@ class SceneTable {
   std::array<double, 2> vec2(std::string_view key, std::array<double, 2> fallback) const;
   std::vector<double> numbers(std::string_view key) const;
   std::vector<double> numbers(std::string_view key, std::vector<double> fallback) const;
+  std::vector<std::string> strings(std::string_view key) const;
+  std::vector<std::string> strings(std::string_view key, std::vector<std::string> fallback) const;
   // A file path relative to the scene file's folder; it must exist.
   std::filesystem::path existing_file(std::string_view key) const;
 

@@ -1,9 +1,11 @@
 // The coupler's step sequence (DESIGN.md §3; message order in common/PROTOCOL.md).
 #include "coupler.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <toml.hpp>
 
 #include "driver.hpp"
@@ -13,34 +15,65 @@ namespace coupler {
 using fsi::Role;
 
 Coupler::Coupler(fsi::Runtime& rt) : m_rt(rt) {
-  if (const auto c = rt.root().optional_table("coupler")) c->finish();
+  if (const auto c = rt.root().optional_table("coupler")) {
+    for (const auto& f : c->tables("force")) {
+      ForceGroup g;
+      g.name = f.string("name");
+      g.body_names = f.strings("bodies");
+      f.finish();
+      m_force_groups.push_back(g);
+    }
+    c->finish();
+  }
 }
 
 void Coupler::run() {
   setup();
+  const auto& s = m_rt.settings();
+  fsi::Progress::Options po;
+  po.every_steps = s.progress_every;
+  m_progress = std::make_unique<fsi::Progress>("[coupler]", s.steps, fsi::step_time(s, s.steps), po);
   m_t_start = m_rt.wall_seconds();
-  for (long n = 0; n < m_rt.settings().steps; ++n) step(n);
+  for (long n = 0; n < s.steps; ++n) step(n);
   finish();
 }
+
+namespace {
+
+// ρ_f ∫ v dA over a body in its current configuration (v linear on each triangle).
+double body_momentum(const proto::BodyMesh& b, const std::vector<double>& x,
+                     const std::vector<double>& v, int c, double rho) {
+  double p = 0;
+  for (std::size_t e = 0; e + 2 < b.tri.size(); e += 3) {
+    const int i = b.tri[e], j = b.tri[e + 1], k = b.tri[e + 2];
+    const double area = 0.5 * std::abs((x[2 * j] - x[2 * i]) * (x[2 * k + 1] - x[2 * i + 1]) -
+                                       (x[2 * k] - x[2 * i]) * (x[2 * j + 1] - x[2 * i + 1]));
+    p += area * (v[2 * i + c] + v[2 * j + c] + v[2 * k + c]) / 3.0;
+  }
+  return rho * p;
+}
+
+}  // namespace
 
 // Set-up, once: grid from the fluid; meshes and initial state from the solid; layout from the
 // fiber, then the fibers' root poses at t^0 and their initial state; each solver's effective
 // scene.
 void Coupler::setup() {
+  auto effective = [&](fsi::Link& l, const char* role) {
+    proto::Text t{proto::Tag::effective_scene, {}};
+    l.recv(t);
+    m_effective[role] = t.text;
+  };
   if (has(Role::fluid)) {
     auto& l = m_rt.link(Role::fluid);
     l.recv(m_grid);
-    proto::Text t{proto::Tag::effective_scene, {}};
-    l.recv(t);
-    m_effective["fluid"] = t.text;
+    effective(l, "fluid");
   }
   if (has(Role::solid)) {
     auto& l = m_rt.link(Role::solid);
     l.recv(m_meshes);
     l.recv(m_solid);
-    proto::Text t{proto::Tag::effective_scene, {}};
-    l.recv(t);
-    m_effective["solid"] = t.text;
+    effective(l, "solid");
   }
   if (has(Role::fiber)) {
     auto& l = m_rt.link(Role::fiber);
@@ -51,27 +84,113 @@ void Coupler::setup() {
       if (m_layout.fibers[k].root == 1)
         fsi::fail("fiber '{}' is attached to body '{}': fibers rooted on bodies are not coupled yet",
                   m_layout.fibers[k].name, m_layout.fibers[k].body);
+    if (!m_layout.fibers.empty())
+      fsi::fail("the scene has {} fibers: the fiber-fluid coupling is not available yet",
+                m_layout.fibers.size());
     l.send(m_fiber_in);
     l.recv(m_fiber);
-    proto::Text t{proto::Tag::effective_scene, {}};
-    l.recv(t);
-    m_effective["fiber"] = t.text;
+    effective(l, "fiber");
   }
-  if (!m_meshes.bodies.empty())
-    fsi::fail("the scene has {} solid bodies: the immersed-solid coupling is not available yet",
-              m_meshes.bodies.size());
-  m_solid_in.force.assign(m_meshes.bodies.size(), {});
+
+  const auto& bodies = m_meshes.bodies;
+  if (!bodies.empty()) {
+    if (!has(Role::fluid))
+      fsi::fail("the scene has solid bodies and fibers but no fluid: nothing couples them");
+    m_immersed = std::make_unique<ImmersedSolid>(m_grid, m_meshes);
+    check_bodies_in_domain(0);
+    warn_element_sizes();
+  }
+  m_solid_in.force.assign(bodies.size(), {});
+
+  // Force probes: the scene's groups, or one per body.
+  if (m_force_groups.empty())
+    for (const auto& b : bodies) m_force_groups.push_back({b.name, {b.name}, {}});
+  for (std::size_t g = 0; g < m_force_groups.size(); ++g) {
+    for (const auto& name : m_force_groups[g].body_names) {
+      auto it = std::find_if(bodies.begin(), bodies.end(), [&](const auto& b) { return b.name == name; });
+      if (it == bodies.end()) {
+        std::vector<std::string> names;
+        for (const auto& b : bodies) names.push_back(b.name);
+        throw fsi::InputError(fmt::format(
+            "coupler.force[{}].bodies names body '{}', which the scene does not have (bodies: {}) "
+            "(in {})",
+            g, name, names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", ")),
+            m_rt.scene().file().string()));
+      }
+      m_force_groups[g].bodies.push_back(static_cast<int>(it - bodies.begin()));
+    }
+  }
+  if (!m_force_groups.empty()) {
+    std::vector<std::string> cols;
+    for (const auto& g : m_force_groups) cols.push_back(g.name + ".fx"), cols.push_back(g.name + ".fy");
+    m_probes = std::make_unique<fsi::ProbeCsv>(m_rt.out_dir() / "coupler_forces.csv", cols);
+    m_probe_row.assign(cols.size(), 0.0);
+  }
+  m_momentum.assign(2 * bodies.size(), 0.0);
+  for (std::size_t b = 0; b < bodies.size(); ++b)
+    for (int c = 0; c < 2; ++c)
+      m_momentum[2 * b + c] = body_momentum(bodies[b], m_solid.x[b], m_solid.v[b], c, m_grid.density);
 
   // The effective scene: the coupler's own reading, each solver's table from that solver.
   std::istringstream own(m_rt.scene().effective_toml());
-  auto doc = toml::parse<toml::discard_comments, std::map, std::vector>(
-      own, "effective");
+  auto doc = toml::parse<toml::discard_comments, std::map, std::vector>(own, "effective");
   for (const auto& [role, text] : m_effective) {
     std::istringstream is(text);
     const auto part = toml::parse<toml::discard_comments, std::map, std::vector>(is, role);
     if (part.contains(role)) doc.as_table()[role] = part.at(role);
   }
-  std::ofstream(m_rt.out_dir() / "scene.effective.toml") << toml::format(doc);
+  fsi::write_file_atomically(m_rt.out_dir() / "scene.effective.toml", toml::format(doc));
+}
+
+// A body must stay inside the fluid domain, except across a periodic boundary.
+void Coupler::check_bodies_in_domain(long step) const {
+  const double x0 = m_grid.x_face.front(), x1 = m_grid.x_face.back();
+  const double y0 = m_grid.y_face.front(), y1 = m_grid.y_face.back();
+  for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b) {
+    const auto& x = m_solid.x[b];
+    for (std::size_t k = 0; k + 1 < x.size(); k += 2) {
+      const char* side = nullptr;
+      if (!m_grid.periodic_x && x[k] < x0) side = "left";
+      else if (!m_grid.periodic_x && x[k] > x1) side = "right";
+      else if (!m_grid.periodic_y && x[k + 1] < y0) side = "bottom";
+      else if (!m_grid.periodic_y && x[k + 1] > y1) side = "top";
+      if (side)
+        fsi::fail("body '{}' is outside the fluid domain [{}, {}] x [{}, {}] through its {} "
+                  "boundary at step {}: node {} at ({}, {})",
+                  m_meshes.bodies[b].name, x0, x1, y0, y1, side, step, k / 2, x[k], x[k + 1]);
+    }
+  }
+}
+
+// Elements much larger than the grid spacing are clipped exactly but forced at the grid's
+// resolution; much smaller ones cost clipping work for nothing.
+void Coupler::warn_element_sizes() const {
+  double hmin = 1e300;
+  for (std::size_t i = 0; i + 1 < m_grid.x_face.size(); ++i)
+    hmin = std::min(hmin, m_grid.x_face[i + 1] - m_grid.x_face[i]);
+  for (std::size_t j = 0; j + 1 < m_grid.y_face.size(); ++j)
+    hmin = std::min(hmin, m_grid.y_face[j + 1] - m_grid.y_face[j]);
+  for (const auto& b : m_meshes.bodies) {
+    if (b.tri.empty()) continue;
+    double sum = 0;
+    for (std::size_t e = 0; e + 2 < b.tri.size(); e += 3)
+      for (int k = 0; k < 3; ++k) {
+        const int i = b.tri[e + k], j = b.tri[e + (k + 1) % 3];
+        sum += std::hypot(b.x_ref[2 * j] - b.x_ref[2 * i], b.x_ref[2 * j + 1] - b.x_ref[2 * i + 1]);
+      }
+    const double h = sum / static_cast<double>(b.tri.size());
+    if (h > 4 * hmin)
+      std::fprintf(stderr,
+                   "[coupler] WARNING: body '%s' has elements (mean edge %.3g) much larger than the "
+                   "grid spacing (%.3g): the volume fractions are still exact, but the forcing "
+                   "only resolves the grid\n",
+                   b.name.c_str(), h, hmin);
+    if (h < hmin / 8)
+      std::fprintf(stderr,
+                   "[coupler] WARNING: body '%s' has elements (mean edge %.3g) tiny against the "
+                   "grid spacing (%.3g): clipping costs grow with no gain in the forcing\n",
+                   b.name.c_str(), h, hmin);
+  }
 }
 
 // One step t^n -> t^(n+1), DESIGN.md §3.
@@ -82,31 +201,71 @@ void Coupler::step(long n) {
     if (has(r)) m_rt.link(r).send(sb, n);
   m_rt.check_fault(n);
 
+  // 2: the bodies' footprint, α and ū_s from the solid state at t^n.
+  if (m_immersed) {
+    m_phases.start("footprint");
+    m_immersed->update(m_solid, m_fluid_in.solid_u, m_fluid_in.solid_v);
+    m_phases.stop("footprint");
+  }
+  // 3-4: the fluid step.
   if (has(Role::fluid)) {
+    m_phases.start("fluid");
     auto& l = m_rt.link(Role::fluid);
     l.send(m_fluid_in, n);
     l.recv(m_fluid_out);
+    m_phases.stop("fluid");
   }
+  // 5-6: the exact reaction of f_s on the bodies' nodes.
+  if (m_immersed) {
+    m_phases.start("reaction");
+    m_immersed->reaction(m_fluid_out.fs_u, m_fluid_out.fs_v, m_solid_in.force);
+    m_phases.stop("reaction");
+  }
+  // 7: the solid step.
   if (has(Role::solid)) {
+    m_phases.start("solid");
     auto& l = m_rt.link(Role::solid);
     l.send(m_solid_in, n);
     l.recv(m_solid);
+    m_phases.stop("solid");
+    if (m_immersed) check_bodies_in_domain(n + 1);
   }
+  // 8-9: the fiber step.
   if (has(Role::fiber)) {
+    m_phases.start("fiber");
     auto& l = m_rt.link(Role::fiber);
     l.send(m_fiber_in, n);
     l.recv(m_fiber);
+    m_phases.stop("fiber");
   }
+  write_force_probes(n);
+  m_progress->update(n + 1, fsi::step_time(s, n + 1), s.dt, [&] {
+    return fmt::format("CFL {:.3g}  div {:.1e}", m_fluid_out.cfl, m_fluid_out.max_div);
+  });
+}
 
-  const double wall = m_rt.wall_seconds() - m_t_start;
-  static double last_print = 0;
-  if (wall - last_print > 2.0 || n + 1 == s.steps) {
-    const double rate = (n + 1) / std::max(wall, 1e-9);
-    std::fprintf(stderr, "[coupler] step %ld/%ld  t=%.6g  dt=%.3g  CFL %.3g  %.1f steps/s  ETA %.0f s\n",
-                 n + 1, s.steps, fsi::step_time(s, n + 1), s.dt, m_fluid_out.cfl, rate,
-                 (s.steps - n - 1) / rate);
-    last_print = wall;
+// The hydrodynamic force on each group: F = Σ_a F_a + d/dt (ρ_f ∫ v dA). The first term is the
+// reaction of f_s; the second restores the inertia of the fluid the forcing carries inside the
+// body (DESIGN.md §4.2: ∫ f_s = ρ_f V a_s − traction).
+void Coupler::write_force_probes(long n) {
+  if (!m_probes) return;
+  const auto& bodies = m_meshes.bodies;
+  const double dt = m_rt.settings().dt;
+  std::fill(m_probe_row.begin(), m_probe_row.end(), 0.0);
+  for (std::size_t g = 0; g < m_force_groups.size(); ++g) {
+    for (int b : m_force_groups[g].bodies) {
+      for (int c = 0; c < 2; ++c) {
+        double f = 0;
+        for (std::size_t k = c; k < m_solid_in.force[b].size(); k += 2) f += m_solid_in.force[b][k];
+        const double p = body_momentum(bodies[b], m_solid.x[b], m_solid.v[b], c, m_grid.density);
+        m_probe_row[2 * g + c] += f + (p - m_momentum[2 * b + c]) / dt;
+      }
+    }
   }
+  for (std::size_t b = 0; b < bodies.size(); ++b)
+    for (int c = 0; c < 2; ++c)
+      m_momentum[2 * b + c] = body_momentum(bodies[b], m_solid.x[b], m_solid.v[b], c, m_grid.density);
+  m_probes->write(fsi::step_time(m_rt.settings(), n + 1), m_probe_row);
 }
 
 void Coupler::finish() {
@@ -128,13 +287,14 @@ void Coupler::finish() {
     j["wall_time"][fsi::role_name(r)] = part["wall_time"];
     j[fsi::role_name(r)] = part;
   }
-  const double steps_per_s = s.steps / std::max(m_rt.wall_seconds() - m_t_start, 1e-9);
+  const double loop = std::max(m_rt.wall_seconds() - m_t_start, 1e-9);
   j["wall_time"]["coupler"] = m_rt.wall_seconds();
-  j["coupler"]["steps_per_second"] = steps_per_s;
-  j["coupler"]["us_per_step"] = 1e6 / steps_per_s;
+  j["coupler"]["steps_per_second"] = s.steps / loop;
+  j["coupler"]["us_per_step"] = 1e6 * loop / s.steps;
+  j["coupler"]["phases"] = nlohmann::json::parse(m_phases.to_json().dump());
   fsi::write_summary(m_rt, j);
-  std::fprintf(stderr, "[coupler] done: %ld steps in %.2f s; output in %s\n", s.steps,
-               m_rt.wall_seconds(), m_rt.out_dir().string().c_str());
+  m_progress->finish(s.steps, fsi::step_time(s, s.steps),
+                     fmt::format("output in {}", m_rt.out_dir().string()));
 }
 
 }  // namespace coupler

@@ -7,8 +7,14 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include <memory>
+
+#include "immersed.hpp"
+#include "probes.hpp"
+#include "progress.hpp"
 #include "protocol.hpp"
 #include "runtime.hpp"
+#include "summary.hpp"
 
 namespace coupler {
 
@@ -26,6 +32,16 @@ class Coupler {
   void step(long n);
   void finish();
   bool has(fsi::Role r) const { return m_rt.roles()[r]; }
+  void check_bodies_in_domain(long step) const;
+  void warn_element_sizes() const;
+  void write_force_probes(long step);
+
+  // A named set of bodies whose total hydrodynamic force is a probe ([[coupler.force]]).
+  struct ForceGroup {
+    std::string name;
+    std::vector<std::string> body_names;
+    std::vector<int> bodies;
+  };
 
   fsi::Runtime& m_rt;
   // What the solvers described at set-up.
@@ -40,6 +56,13 @@ class Coupler {
   proto::SolidInput m_solid_in;
   proto::FiberInput m_fiber_in;
   std::map<std::string, std::string> m_effective;  // role -> its effective scene (TOML)
+  std::unique_ptr<ImmersedSolid> m_immersed;
+  std::vector<ForceGroup> m_force_groups;
+  std::vector<double> m_momentum;   // per body: ρ_f ∫ v dA at the last state (for the force probe)
+  std::unique_ptr<fsi::ProbeCsv> m_probes;
+  std::vector<double> m_probe_row;
+  std::unique_ptr<fsi::Progress> m_progress;
+  fsi::PhaseTimer m_phases;
   double m_t_start = 0;
 };
 
