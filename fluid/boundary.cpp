@@ -120,7 +120,8 @@ void Boundaries::advance_normal(Field& u, Field& v, double t, double dt) {
       prev.resize(o.n());
       for (int k = 0; k < o.n(); ++k) prev[k] = at(nf, a, b1, k);
       // Tangential ghost, one cell width beyond the first interior value.
-      const double r_t = (r_sum / o.n()) * w / ax.width(hi ? ax.n() - 1 : 0);
+      // (its distance to the first interior value is the first cell's width, w)
+      const double r_t = r_sum / o.n();
       const int g = hi ? ax.n() : -1, q0 = hi ? ax.n() - 1 : 0;
       for (int k = 0; k <= o.n(); ++k) {
         double& gv = at(tf, a, g, k);
@@ -142,7 +143,7 @@ void Boundaries::advance_normal(Field& u, Field& v, double t, double dt) {
   }
 }
 
-void Boundaries::fill_ghosts(Field& u, Field& v, double /*t*/) const {
+void Boundaries::fill_ghosts(Field& u, Field& v) const {
   const int nx = m_g.nx(), ny = m_g.ny();
   // x-direction sides first (rows of the interior), then y-direction sides over every column.
   if (m_bc[left].type == BcType::periodic) {

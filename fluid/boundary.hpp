@@ -33,8 +33,8 @@ class Boundaries {
   // from their current values over dt, then all outflow faces are shifted by one constant so
   // that the net flux through the boundary is zero. Tangential outflow ghosts are convected too.
   void advance_normal(Field& u, Field& v, double t, double dt);
-  // Tangential ghosts (rules), periodic copies; the wall data at time t.
-  void fill_ghosts(Field& u, Field& v, double t) const;
+  // Tangential ghosts (rules; outflow ghosts keep their convected value) and periodic copies.
+  void fill_ghosts(Field& u, Field& v) const;
   // Periodic copies and zero-gradient ghosts of a cell-centred field (pressure).
   void fill_scalar(Field& p) const;
   // Net volume flux into the domain through its boundary (per unit depth).

@@ -128,7 +128,7 @@ Solver::Solver(const Config& c, double dt)
     m_lv = Field(nx, ny + 1);
     build_implicit(dt);
   }
-  m_bnd.fill_ghosts(m_u, m_v, 0.0);
+  m_bnd.fill_ghosts(m_u, m_v);
 }
 
 Solver::~Solver() = default;
@@ -177,7 +177,7 @@ void Solver::step(double dt, const CouplingIn& in, CouplingOut& out) {
   // Boundary values at t^{n+1}; Crank-Nicolson also needs the ghosts with the new wall data.
   t0 = Clock::now();
   m_bnd.advance_normal(m_u, m_v, t_new, dt);
-  if (imp) m_bnd.fill_ghosts(m_u, m_v, t_new);
+  if (imp) m_bnd.fill_ghosts(m_u, m_v);
   m_time.boundaries += since(t0);
 
   t0 = Clock::now();
@@ -194,7 +194,7 @@ void Solver::step(double dt, const CouplingIn& in, CouplingOut& out) {
   project(dt);
 
   t0 = Clock::now();
-  m_bnd.fill_ghosts(m_u, m_v, t_new);
+  m_bnd.fill_ghosts(m_u, m_v);
   const int nu = m_grid.nu(), nx = m_grid.nx();
   out.sample_u.resize(in.sample_u_index.size());
   out.sample_v.resize(in.sample_v_index.size());
@@ -451,7 +451,7 @@ void Solver::project_initial() {
   const Field p = m_p;
   project(1.0);
   m_p = p;
-  m_bnd.fill_ghosts(m_u, m_v, m_t);
+  m_bnd.fill_ghosts(m_u, m_v);
 }
 
 void set_initial(Solver& s) {

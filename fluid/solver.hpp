@@ -81,9 +81,6 @@ class Solver {
   const Field& p() const { return m_p; }
   // Make the current velocity discretely divergence-free (boundary values at the current time).
   void project_initial();
-  // Restart support: the AB2 history and the clock.
-  const Field& convection_u() const { return m_hu_old; }
-  const Field& convection_v() const { return m_hv_old; }
 
   // First active u column (0 if x periodic, else 1) and v row.
   int i0() const { return m_i0; }
