@@ -1,0 +1,158 @@
+// Peskin-delta interpolation and spreading on the staggered grid (see ib.hpp).
+#include "ib.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "error.hpp"
+
+namespace coupler {
+
+double peskin4(double r) {
+  const double a = std::abs(r);
+  if (a <= 1) return (3 - 2 * a + std::sqrt(1 + 4 * a - 4 * a * a)) / 8;
+  if (a <= 2) return (5 - 2 * a - std::sqrt(std::max(0.0, -7 + 12 * a - 4 * a * a))) / 8;
+  return 0;
+}
+
+namespace {
+bool uniform(const std::vector<double>& f, double& h) {
+  const int n = static_cast<int>(f.size()) - 1;
+  h = (f[n] - f[0]) / n;
+  for (int i = 0; i < n; ++i)
+    if (std::abs(f[i + 1] - f[i] - h) > 1e-9 * h) return false;
+  return true;
+}
+}  // namespace
+
+FeedbackIB::FeedbackIB(const proto::GridInfo& g) {
+  if (!uniform(g.x_face, m_hx) || !uniform(g.y_face, m_hy))
+    fsi::fail("fibers need a uniform fluid grid (the delta function's moment conditions hold on "
+              "a uniform grid only); this grid is stretched");
+  m_lx = g.x_face.back() - g.x_face.front();
+  m_ly = g.y_face.back() - g.y_face.front();
+  // u-faces at (x_face[i], y_centre[j]); v-faces at (x_centre[i], y_face[j]).
+  m_u.ni = g.periodic_x ? g.nx : g.nx + 1, m_u.nj = g.ny;
+  m_u.x0 = g.x_face[0], m_u.y0 = g.y_face[0] + 0.5 * m_hy;
+  m_v.ni = g.nx, m_v.nj = g.periodic_y ? g.ny : g.ny + 1;
+  m_v.x0 = g.x_face[0] + 0.5 * m_hx, m_v.y0 = g.y_face[0];
+  for (Family* f : {&m_u, &m_v}) {
+    f->px = g.periodic_x != 0, f->py = g.periodic_y != 0;
+    const std::size_t n = static_cast<std::size_t>(f->ni) * f->nj;
+    f->value.assign(n, 0.0), f->has_value.assign(n, 0), f->force.assign(n, 0.0);
+  }
+}
+
+void FeedbackIB::kernel(const Family& f, double X, double Y, std::int32_t idx[16], double w[16]) const {
+  const double sx = (X - f.x0) / m_hx, sy = (Y - f.y0) / m_hy;
+  const int i0 = static_cast<int>(std::floor(sx)) - 1, j0 = static_cast<int>(std::floor(sy)) - 1;
+  double wx[4], wy[4];
+  int ii[4], jj[4];
+  for (int k = 0; k < 4; ++k) {
+    wx[k] = peskin4(sx - (i0 + k));
+    wy[k] = peskin4(sy - (j0 + k));
+    int i = i0 + k, j = j0 + k;
+    if (f.px) i = ((i % f.ni) + f.ni) % f.ni;
+    else if (i < 0 || i >= f.ni) i = -1;
+    if (f.py) j = ((j % f.nj) + f.nj) % f.nj;
+    else if (j < 0 || j >= f.nj) j = -1;
+    ii[k] = i, jj[k] = j;
+  }
+  for (int b = 0; b < 4; ++b)
+    for (int a = 0; a < 4; ++a) {
+      idx[4 * b + a] = (ii[a] < 0 || jj[b] < 0) ? -1 : ii[a] + f.ni * jj[b];
+      w[4 * b + a] = wx[a] * wy[b];
+    }
+}
+
+void FeedbackIB::stencil(const std::vector<std::vector<double>>& markers, int margin,
+                         std::vector<std::int32_t>& u_faces, std::vector<std::int32_t>& v_faces) const {
+  for (auto [f, out] : {std::pair{&m_u, &u_faces}, std::pair{&m_v, &v_faces}}) {
+    out->clear();
+    for (const auto& x : markers) {
+      for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
+        const int ic = static_cast<int>(std::floor((x[m] - f->x0) / m_hx));
+        const int jc = static_cast<int>(std::floor((x[m + 1] - f->y0) / m_hy));
+        for (int j = jc - 1 - margin; j <= jc + 2 + margin; ++j)
+          for (int i = ic - 1 - margin; i <= ic + 2 + margin; ++i) {
+            int a = i, b = j;
+            if (f->px) a = ((a % f->ni) + f->ni) % f->ni;
+            else if (a < 0 || a >= f->ni) continue;
+            if (f->py) b = ((b % f->nj) + f->nj) % f->nj;
+            else if (b < 0 || b >= f->nj) continue;
+            out->push_back(a + f->ni * b);
+          }
+      }
+    }
+    std::sort(out->begin(), out->end());
+    out->erase(std::unique(out->begin(), out->end()), out->end());
+  }
+}
+
+void FeedbackIB::store_samples(const std::vector<std::int32_t>& u_faces, const std::vector<double>& u,
+                               const std::vector<std::int32_t>& v_faces, const std::vector<double>& v) {
+  for (auto [f, idx, val] : {std::tuple{&m_u, &u_faces, &u}, std::tuple{&m_v, &v_faces, &v}}) {
+    if (idx->size() != val->size())
+      fsi::fail("protocol error: {} velocity samples for {} faces", val->size(), idx->size());
+    std::fill(f->has_value.begin(), f->has_value.end(), 0);
+    for (std::size_t k = 0; k < idx->size(); ++k) {
+      f->value[(*idx)[k]] = (*val)[k];
+      f->has_value[(*idx)[k]] = 1;
+    }
+  }
+}
+
+void FeedbackIB::interpolate(const std::vector<double>& x, std::vector<double>& u) const {
+  u.assign(x.size(), 0.0);
+  std::int32_t idx[16];
+  double w[16];
+  for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
+    for (int c = 0; c < 2; ++c) {
+      const Family& f = c == 0 ? m_u : m_v;
+      kernel(f, x[m], x[m + 1], idx, w);
+      double s = 0;
+      for (int k = 0; k < 16; ++k) {
+        if (idx[k] < 0 || w[k] == 0) continue;
+        if (!f.has_value[idx[k]])
+          fsi::fail("fiber marker at ({}, {}) moved beyond the sampled stencil in one step "
+                    "(more than a grid cell): reduce dt",
+                    x[m], x[m + 1]);
+        s += w[k] * f.value[idx[k]];
+      }
+      u[m + c] = s;
+    }
+  }
+}
+
+void FeedbackIB::spread(const std::vector<double>& x, const std::vector<double>& F, double ds) {
+  std::int32_t idx[16];
+  double w[16];
+  const double scale = -ds / (m_hx * m_hy);
+  for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
+    for (int c = 0; c < 2; ++c) {
+      Family& f = c == 0 ? m_u : m_v;
+      kernel(f, x[m], x[m + 1], idx, w);
+      for (int k = 0; k < 16; ++k) {
+        if (idx[k] < 0 || w[k] == 0) continue;
+        if (f.force[idx[k]] == 0) f.touched.push_back(idx[k]);
+        f.force[idx[k]] += scale * F[m + c] * w[k];
+      }
+    }
+  }
+}
+
+void FeedbackIB::take_spread(proto::FaceForce& u, proto::FaceForce& v) {
+  for (auto [f, out] : {std::pair{&m_u, &u}, std::pair{&m_v, &v}}) {
+    std::sort(f->touched.begin(), f->touched.end());
+    f->touched.erase(std::unique(f->touched.begin(), f->touched.end()), f->touched.end());
+    out->index = f->touched;
+    out->force.resize(f->touched.size());
+    for (std::size_t k = 0; k < f->touched.size(); ++k) {
+      out->force[k] = f->force[f->touched[k]];
+      f->force[f->touched[k]] = 0;
+    }
+    f->touched.clear();
+  }
+}
+
+}  // namespace coupler

@@ -1,0 +1,70 @@
+// The feedback immersed boundary transfers for fibers (paper Sec. 3.2.2; Huang & Sung 2009):
+// interpolation of the fluid velocity to the markers and spreading of marker forces to the faces
+// of the staggered grid with Peskin's 4-point delta, as exact transposes of each other.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "protocol.hpp"
+
+namespace coupler {
+
+namespace proto = fsi::proto;
+
+// Peskin's 4-point kernel φ(r) (Peskin 2002, Acta Numerica 11, Eq. 6.27):
+//   |r| <= 1:     (3 − 2|r| + sqrt(1 + 4|r| − 4r²)) / 8
+//   1 <= |r| <= 2: (5 − 2|r| − sqrt(−7 + 12|r| − 4r²)) / 8
+// Σ_i φ(r − i) = 1 and Σ_i (r − i) φ(r − i) = 0 for every r, so constants and linear fields are
+// interpolated exactly and spreading conserves force.
+double peskin4(double r);
+
+class FeedbackIB {
+ public:
+  // The grid must be uniform in each direction where fibers are (checked here for the whole
+  // grid: the delta function's moment conditions hold on a uniform grid only).
+  explicit FeedbackIB(const proto::GridInfo& grid);
+
+  // The u- and v-faces within the kernels of markers x (interleaved), dilated by `margin` cells,
+  // sorted: the faces whose velocity the coupler asks the fluid for. Faces on a non-periodic
+  // boundary are included (they hold boundary values).
+  void stencil(const std::vector<std::vector<double>>& markers, int margin,
+               std::vector<std::int32_t>& u_faces, std::vector<std::int32_t>& v_faces) const;
+
+  // Remember sampled face velocities (the fluid's answer to a stencil request).
+  void store_samples(const std::vector<std::int32_t>& u_faces, const std::vector<double>& u,
+                     const std::vector<std::int32_t>& v_faces, const std::vector<double>& v);
+
+  // U(X) = Σ_faces u_f φ((x_f − X)/h_x) φ((y_f − Y)/h_y) at each marker, from stored samples. A
+  // face of the kernel that was not sampled is an error (a marker moved more than the margin).
+  void interpolate(const std::vector<double>& x, std::vector<double>& u) const;
+
+  // The force per unit volume on the fluid from forces per unit length F on the markers of one
+  // fiber of spacing ds: f(x_f) = −Σ_m F_m ds φ(..)φ(..)/(h_x h_y), accumulated into `u`/`v`
+  // (dense per family, indexed by face) and the touched faces recorded.
+  void spread(const std::vector<double>& x, const std::vector<double>& F, double ds);
+  // The accumulated spread force as sparse face lists (sorted), then cleared.
+  void take_spread(proto::FaceForce& u, proto::FaceForce& v);
+
+  double hx() const { return m_hx; }
+  double hy() const { return m_hy; }
+
+ private:
+  struct Family {
+    int ni = 0, nj = 0;          // faces along x, y; flat index i + ni*j
+    double x0 = 0, y0 = 0;       // position of face (0, 0)
+    bool px = false, py = false; // periodic
+    std::vector<double> value;   // sampled velocity per face
+    std::vector<char> has_value;
+    std::vector<double> force;   // spread force per face
+    std::vector<std::int32_t> touched;
+  };
+  // The 4 × 4 kernel of point (X, Y) on a family: face indices (−1 outside a bounded grid) and
+  // weights φ φ.
+  void kernel(const Family& f, double X, double Y, std::int32_t idx[16], double w[16]) const;
+
+  double m_hx, m_hy, m_lx, m_ly;
+  Family m_u, m_v;
+};
+
+}  // namespace coupler

@@ -1,0 +1,146 @@
+// Feedback-IB transfers: the kernel's moment conditions, exact interpolation of linear fields
+// (also across a periodic boundary), conservation of spread force, interpolation = spreading^T.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <random>
+
+#include "ib.hpp"
+
+using namespace coupler;
+
+namespace {
+
+proto::GridInfo grid(int nx, int ny, double lx, double ly, bool px, bool py) {
+  proto::GridInfo g;
+  g.nx = nx, g.ny = ny, g.periodic_x = px, g.periodic_y = py, g.density = 1;
+  for (int i = 0; i <= nx; ++i) g.x_face.push_back(lx * i / nx);
+  for (int j = 0; j <= ny; ++j) g.y_face.push_back(ly * j / ny);
+  return g;
+}
+
+// Face positions of the two families (u: (x_face[i], y_centre[j]), v: (x_centre[i], y_face[j])).
+void face_xy(const proto::GridInfo& g, int c, std::int32_t f, double& x, double& y) {
+  const double hx = g.x_face[1] - g.x_face[0], hy = g.y_face[1] - g.y_face[0];
+  const int ni = c == 0 ? (g.periodic_x ? g.nx : g.nx + 1) : g.nx;
+  const int i = f % ni, j = f / ni;
+  x = g.x_face[0] + (c == 0 ? i * hx : (i + 0.5) * hx);
+  y = g.y_face[0] + (c == 0 ? (j + 0.5) * hy : j * hy);
+}
+
+}  // namespace
+
+TEST_CASE("Peskin's 4-point kernel: partition of unity and zero first moment") {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> r(-0.5, 0.5);
+  for (int t = 0; t < 1000; ++t) {
+    const double s = r(rng);
+    double m0 = 0, m1 = 0;
+    for (int i = -3; i <= 3; ++i) m0 += peskin4(s - i), m1 += (s - i) * peskin4(s - i);
+    CHECK(std::abs(m0 - 1) <= 1e-15);
+    CHECK(std::abs(m1) <= 1e-15);
+  }
+}
+
+TEST_CASE("interpolation is exact for linear fields and, across periodic boundaries, constants") {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> r(0, 1);
+  SECTION("linear field, markers anywhere at least 2 cells from the walls") {
+    const auto g = grid(40, 30, 2.0, 1.5, false, false);
+    FeedbackIB ib(g);
+    std::vector<double> x;
+    for (int m = 0; m < 50; ++m) x.push_back(0.2 + 1.6 * r(rng)), x.push_back(0.2 + 1.1 * r(rng));
+    std::vector<std::int32_t> fu, fv;
+    ib.stencil({x}, 0, fu, fv);
+    auto lin_u = [](double px, double py) { return 0.3 + 1.7 * px - 0.9 * py; };
+    auto lin_v = [](double px, double py) { return -1.1 + 0.4 * px + 2.2 * py; };
+    std::vector<double> u(fu.size()), v(fv.size());
+    for (std::size_t k = 0; k < fu.size(); ++k) {
+      double px, py;
+      face_xy(g, 0, fu[k], px, py);
+      u[k] = lin_u(px, py);
+    }
+    for (std::size_t k = 0; k < fv.size(); ++k) {
+      double px, py;
+      face_xy(g, 1, fv[k], px, py);
+      v[k] = lin_v(px, py);
+    }
+    ib.store_samples(fu, u, fv, v);
+    std::vector<double> U;
+    ib.interpolate(x, U);
+    for (std::size_t m = 0; m < x.size(); m += 2) {
+      CHECK(std::abs(U[m] - lin_u(x[m], x[m + 1])) <= 1e-13);
+      CHECK(std::abs(U[m + 1] - lin_v(x[m], x[m + 1])) <= 1e-13);
+    }
+  }
+  SECTION("constant field across the periodic boundaries") {
+    const auto g = grid(32, 32, 1.0, 1.0, true, true);
+    FeedbackIB ib(g);
+    const std::vector<double> x = {0.001, 0.5, 0.999, 0.002, 0.98, 0.99, 0.5, 0.5};
+    std::vector<std::int32_t> fu, fv;
+    ib.stencil({x}, 1, fu, fv);
+    ib.store_samples(fu, std::vector<double>(fu.size(), 0.7), fv, std::vector<double>(fv.size(), -0.2));
+    std::vector<double> U;
+    ib.interpolate(x, U);
+    for (std::size_t m = 0; m < x.size(); m += 2) {
+      CHECK(std::abs(U[m] - 0.7) <= 1e-14);
+      CHECK(std::abs(U[m + 1] + 0.2) <= 1e-14);
+    }
+  }
+  SECTION("a marker outside the sampled stencil is an error") {
+    const auto g = grid(32, 32, 1.0, 1.0, true, true);
+    FeedbackIB ib(g);
+    std::vector<std::int32_t> fu, fv;
+    ib.stencil({{0.5, 0.5}}, 0, fu, fv);
+    ib.store_samples(fu, std::vector<double>(fu.size(), 1.0), fv, std::vector<double>(fv.size(), 1.0));
+    std::vector<double> U;
+    CHECK_THROWS_WITH(ib.interpolate({0.6, 0.5}, U), Catch::Contains("moved beyond the sampled stencil"));
+  }
+}
+
+TEST_CASE("spreading conserves force and is the transpose of interpolation") {
+  const auto g = grid(48, 40, 1.2, 1.0, true, false);
+  FeedbackIB ib(g);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> r(-1, 1);
+  // A fiber that crosses the periodic boundary x = 0.
+  std::vector<double> x, F;
+  for (int m = 0; m < 40; ++m) {
+    x.push_back(std::fmod(1.1 + 0.004 * m * 1.0 + 1.2, 1.2));
+    x.push_back(0.3 + 0.01 * m);
+    F.push_back(r(rng)), F.push_back(r(rng));
+  }
+  const double ds = 0.01;
+  ib.spread(x, F, ds);
+  proto::FaceForce fu, fv;
+  ib.take_spread(fu, fv);
+  const double cell = ib.hx() * ib.hy();
+  double sx = 0, sy = 0, tx = 0, ty = 0, scale = 0;
+  for (double f : fu.force) sx += f * cell, scale += std::abs(f * cell);
+  for (double f : fv.force) sy += f * cell;
+  for (std::size_t m = 0; m < F.size(); m += 2) tx += F[m] * ds, ty += F[m + 1] * ds;
+  CHECK(std::abs(sx + tx) <= 1e-12 * scale);
+  CHECK(std::abs(sy + ty) <= 1e-12 * scale);
+
+  // <spread(F), u>_grid = −<F, interp(u)>_markers for an arbitrary velocity u.
+  std::vector<std::int32_t> su, sv;
+  ib.stencil({x}, 0, su, sv);
+  std::vector<double> u(su.size()), v(sv.size());
+  for (auto& a : u) a = r(rng);
+  for (auto& a : v) a = r(rng);
+  ib.store_samples(su, u, sv, v);
+  std::vector<double> U;
+  ib.interpolate(x, U);
+  double grid_side = 0, marker_side = 0;
+  for (std::size_t k = 0; k < fu.index.size(); ++k)
+    grid_side += fu.force[k] * cell * u[std::lower_bound(su.begin(), su.end(), fu.index[k]) - su.begin()];
+  for (std::size_t k = 0; k < fv.index.size(); ++k)
+    grid_side += fv.force[k] * cell * v[std::lower_bound(sv.begin(), sv.end(), fv.index[k]) - sv.begin()];
+  for (std::size_t m = 0; m < F.size(); ++m) marker_side += F[m] * U[m] * ds;
+  CHECK(std::abs(grid_side + marker_side) <= 1e-12 * std::abs(marker_side));
+}
+
+TEST_CASE("a stretched grid is refused for fibers") {
+  auto g = grid(8, 8, 1.0, 1.0, false, false);
+  g.y_face[3] += 0.01;
+  CHECK_THROWS_WITH(FeedbackIB(g), Catch::Contains("fibers need a uniform fluid grid"));
+}
