@@ -6,7 +6,6 @@
 #include <fstream>
 #include <map>
 #include <numeric>
-#include <regex>
 #include <sstream>
 
 #include "h5.hpp"
@@ -198,16 +197,28 @@ std::vector<std::string> xdmf_check(const std::filesystem::path& xdmf) {
   if (text.find("<Xdmf") == std::string::npos || text.find("</Xdmf>") == std::string::npos)
     problems.push_back(fmt::format("{}: no <Xdmf> ... </Xdmf> element", xdmf.string()));
 
-  const std::regex item_re(R"(<DataItem([^>]*)>([^<]*)</DataItem>)");
-  const std::regex attr_re(R"re((\w+)="([^"]*)")re");
   std::map<std::string, H5File> files;
   std::size_t n_items = 0;
-  for (std::sregex_iterator it(text.begin(), text.end(), item_re), end; it != end; ++it) {
+  // Each <DataItem attr="..." ...>file.h5:/dataset</DataItem> (the form this writer produces).
+  for (std::size_t open = text.find("<DataItem"); open != std::string::npos;
+       open = text.find("<DataItem", open + 1)) {
+    std::size_t head_end = text.find('>', open), close = text.find("</DataItem>", open);
+    if (head_end == std::string::npos || close == std::string::npos || close < head_end) {
+      problems.push_back(fmt::format("{}: unterminated DataItem", xdmf.string()));
+      break;
+    }
     ++n_items;
     std::map<std::string, std::string> attrs;
-    const std::string head = (*it)[1];
-    for (std::sregex_iterator a(head.begin(), head.end(), attr_re); a != end; ++a) attrs[(*a)[1]] = (*a)[2];
-    std::string ref = xml_unescape((*it)[2]);
+    const std::string head = text.substr(open + 9, head_end - open - 9);
+    for (std::size_t eq = head.find("=\""); eq != std::string::npos; eq = head.find("=\"", eq + 1)) {
+      std::size_t key_start = head.rfind(' ', eq) + 1, value_end = head.find('"', eq + 2);
+      if (value_end == std::string::npos) break;
+      attrs[head.substr(key_start, eq - key_start)] = head.substr(eq + 2, value_end - eq - 2);
+      eq = value_end;
+    }
+    std::string ref = xml_unescape(text.substr(head_end + 1, close - head_end - 1));
+    ref.erase(0, ref.find_first_not_of(" \t\r\n"));
+    ref.erase(ref.find_last_not_of(" \t\r\n") + 1);
     auto say = [&](const std::string& what) { problems.push_back(fmt::format("{}: '{}': {}", xdmf.string(), ref, what)); };
     if (attrs["Format"] != "HDF") {
       say("Format is not HDF");
