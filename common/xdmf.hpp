@@ -3,6 +3,15 @@
 // rectilinear grid, a triangle mesh, or a set of polylines); after each appended step the whole
 // file is rewritten through a temporary and a rename, so it is valid at any moment of a run.
 // Datasets are referenced by the .h5 path relative to the .xdmf file's folder.
+//
+//   H5File h5(out / "fluid.h5", H5File::Mode::truncate);
+//   h5.write("/grid/xf", xf);  h5.write("/grid/yf", yf);             // nx + 1, ny + 1 faces
+//   XdmfWriter xdmf(out / "fluid.xdmf", out / "fluid.h5",
+//                   XdmfRectilinear{"/grid/xf", nx + 1, "/grid/yf", ny + 1}, "fluid");
+//   // each output step:
+//   std::string g = h5_step_group(step);
+//   h5.write_window(g + "/p", p, {ny + 2 * ng, nx + 2 * ng}, {ng, ng}, {ny, nx});
+//   xdmf.add_step(t, {{"p", XdmfCenter::cell, g + "/p"}});
 #pragma once
 
 #include <cstddef>
