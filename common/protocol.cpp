@@ -88,7 +88,7 @@ void FiberLayout::pack(Writer& w) const {
   w.put(static_cast<std::int64_t>(fibers.size()));
   for (const auto& f : fibers)
     w.put(f.name), w.put(f.markers), w.put(f.ds), w.put(f.root), w.put(f.body), w.put(f.edge),
-        w.put(f.edge_s);
+        w.put(f.edge_s), w.put(f.root_x), w.put(f.root_y), w.put(f.line_density);
 }
 void FiberLayout::unpack(Reader& r) {
   std::int64_t n = 0;
@@ -97,7 +97,7 @@ void FiberLayout::unpack(Reader& r) {
   fibers.resize(static_cast<std::size_t>(n));
   for (auto& f : fibers)
     r.get(f.name), r.get(f.markers), r.get(f.ds), r.get(f.root), r.get(f.body), r.get(f.edge),
-        r.get(f.edge_s);
+        r.get(f.edge_s), r.get(f.root_x), r.get(f.root_y), r.get(f.line_density);
 }
 
 void Text::pack(Writer& w) const { w.put(text); }

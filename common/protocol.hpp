@@ -138,8 +138,10 @@ struct FiberLayout1 {
   double ds = 0;                 // arclength spacing
   std::int32_t root = 0;         // 0 free/clamped/hinged at a fixed point, 1 attached to a body
   std::string body;              // attached: body name
-  std::int32_t edge = -1;        // attached: surface edge index of that body
-  double edge_s = 0;             // attached: parameter along the edge, 0..1
+  std::int32_t edge = -1;        // attached: surface edge index of that body, or −1: the coupler
+  double edge_s = 0;             //   finds the edge nearest to root_ref; parameter along it, 0..1
+  double root_x = 0, root_y = 0; // attached: the root's point in the body's reference configuration
+  double line_density = 0;       // ρ' (excess mass per unit length); <= 0: prescribed motion
 };
 
 struct FiberLayout {  // fiber -> coupler, once

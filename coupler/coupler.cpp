@@ -23,6 +23,9 @@ Coupler::Coupler(fsi::Runtime& rt) : m_rt(rt) {
       f.finish();
       m_force_groups.push_back(g);
     }
+    m_kappa_given = c->has("kappa");
+    if (m_kappa_given) m_kappa = c->positive("kappa");
+    m_kappa_gain = c->in_range("kappa_gain", 0.0, 2.0, true, 0.5);
     c->finish();
   }
 }
@@ -79,19 +82,35 @@ void Coupler::setup() {
     auto& l = m_rt.link(Role::fiber);
     l.recv(m_layout);
     m_fiber_in.force.assign(m_layout.fibers.size(), {});
-    m_fiber_in.root_pose.assign(m_layout.fibers.size(), {});
-    for (std::size_t k = 0; k < m_layout.fibers.size(); ++k)
-      if (m_layout.fibers[k].root == 1)
-        fsi::fail("fiber '{}' is attached to body '{}': fibers rooted on bodies are not coupled yet",
-                  m_layout.fibers[k].name, m_layout.fibers[k].body);
-    if (!m_layout.fibers.empty())
-      fsi::fail("the scene has {} fibers: the fiber-fluid coupling is not available yet",
-                m_layout.fibers.size());
+    resolve_roots();
+    root_poses(m_fiber_in.root_pose);
     l.send(m_fiber_in);
     l.recv(m_fiber);
     effective(l, "fiber");
   }
 
+  if (!m_layout.fibers.empty() && has(Role::fluid)) {
+    m_ib = std::make_unique<FeedbackIB>(m_grid);
+    if (!m_kappa_given) {
+      // Default κ: the feedback acts as a spring between a marker and where the fluid carries it,
+      // applied explicitly. Over one step it closes the fraction
+      //   g = κ Δt² (1/m' + 1/m_f)
+      // of the gap, with m' the fiber's line density (∞ for prescribed motion) and m_f = ρ_f h
+      // a lower bound of the fluid mass per unit length the delta function reaches. g < 2 is the
+      // explicit stability bound of that spring; the default takes g = coupler.kappa_gain (0.5)
+      // for the lightest fiber.
+      const double h = std::min(m_ib->hx(), m_ib->hy());
+      const double dt = m_rt.settings().dt;
+      double inv_mass = 1.0 / (m_grid.density * h);
+      double lightest = 0;
+      for (const auto& f : m_layout.fibers)
+        if (f.line_density > 0) lightest = std::max(lightest, 1.0 / f.line_density);
+      inv_mass += lightest;
+      m_kappa = m_kappa_gain / (dt * dt * inv_mass);
+      std::fprintf(stderr, "[coupler] feedback stiffness kappa = %.4g (gain %.2g at dt = %.3g)\n",
+                   m_kappa, m_kappa_gain, dt);
+    }
+  }
   const auto& bodies = m_meshes.bodies;
   if (!bodies.empty()) {
     if (!has(Role::fluid))
@@ -101,6 +120,13 @@ void Coupler::setup() {
     warn_element_sizes();
   }
   m_solid_in.force.assign(bodies.size(), {});
+  if (m_ib)
+    for (const auto& f : m_layout.fibers)
+      if (f.ds > 2 * std::max(m_ib->hx(), m_ib->hy()))
+        std::fprintf(stderr,
+                     "[coupler] WARNING: fiber '%s' has markers %.3g apart, more than twice the grid "
+                     "spacing: the fluid leaks between them\n",
+                     f.name.c_str(), f.ds);
 
   // Force probes: the scene's groups, or one per body.
   if (m_force_groups.empty())
@@ -207,6 +233,12 @@ void Coupler::step(long n) {
     m_immersed->update(m_solid, m_fluid_in.solid_u, m_fluid_in.solid_v);
     m_phases.stop("footprint");
   }
+  // 2: the fibers' feedback force from U(X^n), its spread, and the faces to sample next.
+  if (m_ib) {
+    m_phases.start("fibers");
+    feedback_forces();
+    m_phases.stop("fibers");
+  }
   // 3-4: the fluid step.
   if (has(Role::fluid)) {
     m_phases.start("fluid");
@@ -214,6 +246,11 @@ void Coupler::step(long n) {
     l.send(m_fluid_in, n);
     l.recv(m_fluid_out);
     m_phases.stop("fluid");
+    if (m_ib) {
+      m_ib->store_samples(m_fluid_in.sample_u, m_fluid_out.u_sample, m_fluid_in.sample_v,
+                          m_fluid_out.v_sample);
+      m_have_samples = true;
+    }
   }
   // 5-6: the exact reaction of f_s on the bodies' nodes.
   if (m_immersed) {
@@ -221,6 +258,7 @@ void Coupler::step(long n) {
     m_immersed->reaction(m_fluid_out.fs_u, m_fluid_out.fs_v, m_solid_in.force);
     m_phases.stop("reaction");
   }
+  add_root_loads();
   // 7: the solid step.
   if (has(Role::solid)) {
     m_phases.start("solid");
@@ -230,8 +268,9 @@ void Coupler::step(long n) {
     m_phases.stop("solid");
     if (m_immersed) check_bodies_in_domain(n + 1);
   }
-  // 8-9: the fiber step.
+  // 8-9: the fiber step, with the root poses from the solid's new state.
   if (has(Role::fiber)) {
+    root_poses(m_fiber_in.root_pose);
     m_phases.start("fiber");
     auto& l = m_rt.link(Role::fiber);
     l.send(m_fiber_in, n);
@@ -242,6 +281,106 @@ void Coupler::step(long n) {
   m_progress->update(n + 1, fsi::step_time(s, n + 1), s.dt, [&] {
     return fmt::format("CFL {:.3g}  div {:.1e}", m_fluid_out.cfl, m_fluid_out.max_div);
   });
+}
+
+// Attached fibers: the body by name, and the surface edge nearest to the root's reference point
+// (it must lie on the surface: within a thousandth of the edge's length).
+void Coupler::resolve_roots() {
+  const auto& bodies = m_meshes.bodies;
+  m_roots.assign(m_layout.fibers.size(), Root{});
+  for (std::size_t k = 0; k < m_layout.fibers.size(); ++k) {
+    const auto& f = m_layout.fibers[k];
+    if (f.root != 1) continue;
+    auto it = std::find_if(bodies.begin(), bodies.end(), [&](const auto& b) { return b.name == f.body; });
+    if (it == bodies.end()) {
+      std::vector<std::string> names;
+      for (const auto& b : bodies) names.push_back(b.name);
+      throw fsi::InputError(fmt::format(
+          "fiber '{}' is rooted on body '{}', which the scene does not have (bodies: {}) (in {})",
+          f.name, f.body, names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", ")),
+          m_rt.scene().file().string()));
+    }
+    const auto& b = *it;
+    Root r;
+    r.body = static_cast<int>(it - bodies.begin());
+    double best = 1e300, best_len = 0;
+    for (std::size_t e = 0; e + 1 < b.edges.size(); e += 2) {
+      const int a = b.edges[e], c = b.edges[e + 1];
+      const double ax = b.x_ref[2 * a], ay = b.x_ref[2 * a + 1];
+      const double dx = b.x_ref[2 * c] - ax, dy = b.x_ref[2 * c + 1] - ay;
+      const double len2 = dx * dx + dy * dy;
+      const double s = std::clamp(((f.root_x - ax) * dx + (f.root_y - ay) * dy) / len2, 0.0, 1.0);
+      const double d = std::hypot(ax + s * dx - f.root_x, ay + s * dy - f.root_y);
+      if (d < best) best = d, best_len = std::sqrt(len2), r.a = a, r.b = c, r.s = s;
+    }
+    if (b.edges.empty() || best > 1e-3 * best_len)
+      throw fsi::InputError(fmt::format(
+          "fiber '{}': its root ({}, {}) is not on the surface of body '{}' (nearest surface point "
+          "{:.3g} away) (in {})",
+          f.name, f.root_x, f.root_y, f.body, best, m_rt.scene().file().string()));
+    m_roots[k] = r;
+  }
+}
+
+// Root pose of each attached fiber from the current solid state: the material point of its edge,
+// and the edge's outward normal (the body lies on the left of a -> b).
+void Coupler::root_poses(std::vector<std::vector<double>>& poses) const {
+  poses.assign(m_layout.fibers.size(), {});
+  for (std::size_t k = 0; k < m_roots.size(); ++k) {
+    const Root& r = m_roots[k];
+    if (r.body < 0) continue;
+    const auto& x = m_solid.x[r.body];
+    const double ax = x[2 * r.a], ay = x[2 * r.a + 1], dx = x[2 * r.b] - ax, dy = x[2 * r.b + 1] - ay;
+    const double len = std::hypot(dx, dy);
+    poses[k] = {ax + r.s * dx, ay + r.s * dy, dy / len, -dx / len};
+  }
+}
+
+// The fiber's load on its support (force F, moment M at the root point p) as equivalent nodal
+// forces on the edge a -> b that holds it (paper Sec. 3.2.3, Fig. 2):
+//   f_a = (1 − s) F − q n,  f_b = s F + q n,  n = (−t_y, t_x), q = M / L,
+// with t the edge's unit tangent and L its length: the resultant is F, and the moment about p is
+// (1 − s)(x_a − p) × F + s (x_b − p) × F + q (x_b − x_a) × n = 0 + q L = M, exactly.
+void Coupler::add_root_loads() {
+  for (std::size_t k = 0; k < m_roots.size(); ++k) {
+    const Root& r = m_roots[k];
+    if (r.body < 0 || m_fiber.root_load.size() < 3 * (k + 1)) continue;
+    const double fx = m_fiber.root_load[3 * k], fy = m_fiber.root_load[3 * k + 1];
+    const double M = m_fiber.root_load[3 * k + 2];
+    const auto& x = m_solid.x[r.body];
+    const double dx = x[2 * r.b] - x[2 * r.a], dy = x[2 * r.b + 1] - x[2 * r.a + 1];
+    const double len = std::hypot(dx, dy);
+    const double q = M / len, nx = -dy / len, ny = dx / len;
+    auto& f = m_solid_in.force[r.body];
+    if (f.empty()) f.assign(x.size(), 0.0);
+    f[2 * r.a] += (1 - r.s) * fx - q * nx;
+    f[2 * r.a + 1] += (1 - r.s) * fy - q * ny;
+    f[2 * r.b] += r.s * fx + q * nx;
+    f[2 * r.b + 1] += r.s * fy + q * ny;
+  }
+}
+
+// Feedback force on each fiber's markers (paper Eq. 23-24, force per unit length on the fiber):
+//   F = κ (X_ib − 2Xⁿ + X^(n−1)),  X_ib = Xⁿ + Δt U(Xⁿ),
+// i.e. κ Δt (U(Xⁿ) − (Xⁿ − X^(n−1))/Δt): it pulls each marker towards the fluid's velocity. The
+// fluid receives the opposite, spread with the same delta function (Eq. 25). U(Xⁿ) comes from
+// the fluid's samples of uⁿ taken after the previous step; on the very first step there are none
+// and the feedback starts one step later. The faces to sample for the next step are the kernels
+// of Xⁿ widened by one cell (a marker moves less than a cell per step).
+void Coupler::feedback_forces() {
+  const double dt = m_rt.settings().dt;
+  for (std::size_t k = 0; k < m_layout.fibers.size(); ++k) {
+    const auto& X = m_fiber.x[k];
+    const auto& Xo = m_fiber.x_old[k];
+    auto& F = m_fiber_in.force[k];
+    F.assign(X.size(), 0.0);
+    if (!m_have_samples) continue;
+    m_ib->interpolate(X, m_u_markers);
+    for (std::size_t m = 0; m < X.size(); ++m) F[m] = m_kappa * (dt * m_u_markers[m] - (X[m] - Xo[m]));
+    m_ib->spread(X, F, m_layout.fibers[k].ds);
+  }
+  m_ib->take_spread(m_fluid_in.force_u, m_fluid_in.force_v);
+  m_ib->stencil(m_fiber.x, 1, m_fluid_in.sample_u, m_fluid_in.sample_v);
 }
 
 // The hydrodynamic force on each group: F = Σ_a F_a + d/dt (ρ_f ∫ v dA). The first term is the

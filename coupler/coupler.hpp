@@ -9,6 +9,7 @@
 
 #include <memory>
 
+#include "ib.hpp"
 #include "immersed.hpp"
 #include "probes.hpp"
 #include "progress.hpp"
@@ -35,6 +36,18 @@ class Coupler {
   void check_bodies_in_domain(long step) const;
   void warn_element_sizes() const;
   void write_force_probes(long step);
+  void resolve_roots();
+  void root_poses(std::vector<std::vector<double>>& poses) const;
+  void feedback_forces();
+  void add_root_loads();
+
+  // Where an attached fiber's root sits: surface edge `edge` (node a -> node b) of body `body`, at
+  // parameter s along it. body < 0: the fiber is not attached to a body.
+  struct Root {
+    int body = -1;
+    int a = 0, b = 0;
+    double s = 0;
+  };
 
   // A named set of bodies whose total hydrodynamic force is a probe ([[coupler.force]]).
   struct ForceGroup {
@@ -57,6 +70,13 @@ class Coupler {
   proto::FiberInput m_fiber_in;
   std::map<std::string, std::string> m_effective;  // role -> its effective scene (TOML)
   std::unique_ptr<ImmersedSolid> m_immersed;
+  std::unique_ptr<FeedbackIB> m_ib;
+  double m_kappa = 0;          // feedback stiffness (force per length per length), coupler.kappa
+  double m_kappa_gain = 0.5;   // the default rule's one-step gain, see resolve_roots()
+  bool m_kappa_given = false;
+  bool m_have_samples = false; // fluid velocity samples around the markers are stored
+  std::vector<Root> m_roots;
+  std::vector<double> m_u_markers;  // scratch: U(X^n) of one fiber
   std::vector<ForceGroup> m_force_groups;
   std::vector<double> m_momentum;   // per body: ρ_f ∫ v dA at the last state (for the force probe)
   std::unique_ptr<fsi::ProbeCsv> m_probes;

@@ -34,10 +34,12 @@ TEST_CASE("every message survives a round trip") {
   CHECK(bm2.bodies[1].kind == 1);
 
   FiberLayout fl;
-  fl.fibers.push_back({"f0", 63, 0.002, 1, "wall", 12, 0.25});
+  fl.fibers.push_back({"f0", 63, 0.002, 1, "wall", 12, 0.25, 0.5, 0.125, 0.1});
   const auto fl2 = round_trip(fl);
   CHECK(fl2.fibers[0].body == "wall");
   CHECK(fl2.fibers[0].edge_s == 0.25);
+  CHECK(fl2.fibers[0].root_y == 0.125);
+  CHECK(fl2.fibers[0].line_density == 0.1);
 
   Text t{Tag::final_report, "{\"a\": 1}"};
   CHECK(round_trip(t).text == t.text);
