@@ -294,8 +294,11 @@ void FiberSystem::repulsion_forces() {
   std::fill(m_repulsion.begin(), m_repulsion.end(), 0.0);
   m_cells.build(m_x, rep.cutoff);
   const double kr = rep.stiffness;
-  m_cells.for_each_pair(m_x, rep.cutoff, [&](std::size_t i, std::size_t j, double dx, double dy, double r2) {
-    if (m_owner[i] == m_owner[j]) return;
+  const auto fiber_end = [&](std::size_t i) {
+    const Fiber& s = m_fibers[m_owner[i]];
+    return s.offset + s.segments + 1;
+  };
+  m_cells.for_each_pair(m_x, rep.cutoff, fiber_end, [&](std::size_t i, std::size_t j, double dx, double dy, double r2) {
     const double c = kr / (r2 * r2);
     m_repulsion[2 * i] += c * dx;
     m_repulsion[2 * i + 1] += c * dy;

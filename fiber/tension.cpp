@@ -45,7 +45,11 @@ void FiberSystem::solve_tension(int k) {
     r[2 * j + 1] = x[2 * j + 3] - x[2 * j + 1];
   }
 
-  const double tol = m_config.tension_tolerance;
+  // Round-off floor of g_j: positions carry errors of about eps |X|, so |d_j|^2 - ds^2 cannot be
+  // resolved below about eps |X| ds; asking for less would only spend iterations.
+  double extent = 0;
+  for (int i = 0; i <= n; ++i) extent = std::max({extent, std::abs(xh[2 * i]), std::abs(xh[2 * i + 1])});
+  const double tol = std::max(m_config.tension_tolerance, 64 * 2.2e-16 * (1 + extent / ds));
   const int max_it = m_config.tension_iterations;
   int it = 0;
   bool is_polished = false;
