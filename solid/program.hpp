@@ -1,0 +1,50 @@
+// The `solid` program's side of a run: the solid solver behind the driver's SolidPort, alone (a
+// pure-solid scene) or as the solid role of a coupled job. Output: HDF5 + XDMF per body
+// (displacement, velocity, von Mises stress, det F, contact pressure), probe CSV at material
+// points, a history CSV (energies, contact, Newton iterations), eigenmodes; health checks stop
+// the run with a message naming body, element or node, step and time, after writing the state.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "config.hpp"
+#include "driver.hpp"
+#include "h5.hpp"
+#include "probes.hpp"
+#include "solver.hpp"
+#include "xdmf.hpp"
+
+namespace solid {
+
+class SolidProgram : public fsi::SolidPort {
+ public:
+  explicit SolidProgram(fsi::Runtime& rt);
+  fsi::proto::BodyMeshes meshes() const override;
+  void state(fsi::proto::SolidState& s) const override;
+  void advance(const fsi::proto::StepBegin& s, const fsi::proto::SolidInput& in) override;
+  void output(long step, double t, bool fields) override;
+  std::string status() const override;
+  nlohmann::json report() const override;
+
+ private:
+  void write_modes();
+  void write_fields(long step, double t);
+
+  fsi::Runtime& m_rt;
+  Config m_cfg;
+  std::unique_ptr<Solver> m_solver;
+  fsi::H5File m_h5;
+  std::vector<fsi::XdmfWriter> m_xdmf;  // one per body
+  std::optional<fsi::ProbeCsv> m_probes, m_history;
+  std::vector<MeshPoint> m_probe_points;
+  std::vector<double> m_row;
+  std::vector<std::vector<double>> m_external;
+  Modes m_modes;
+  StepReport m_last;
+  long m_newton_total = 0, m_newton_max = 0, m_steps = 0, m_written_step = -1;
+  double m_assembly = 0, m_factor = 0, m_solve = 0;
+};
+
+}  // namespace solid
