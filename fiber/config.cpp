@@ -217,6 +217,7 @@ Config read_config(const fsi::SceneTable& fiber) {
     }
   }
 
+  c.probe_interval = fiber.non_negative("probe_interval", 0.0);
   for (const auto& t : fiber.tables("probe")) {
     ProbeSpec p;
     p.name = t.string("name");

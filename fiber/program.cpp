@@ -83,6 +83,9 @@ fsi::proto::FiberLayout FiberProgram::layout() const {
     one.body = f.root.body;
     one.edge = -1;  // the fiber knows the surface point, not the body's edges: the coupler resolves it
     one.edge_s = 0;
+    one.root_x = f.root.point.x();
+    one.root_y = f.root.point.y();
+    one.line_density = f.is_prescribed() ? 0.0 : f.density;
     l.fibers.push_back(one);
   }
   return l;
@@ -162,7 +165,10 @@ static double along(const std::vector<double>& q, double s, double ds) {
 void FiberProgram::output(long step, double t, bool fields) {
   const FiberSystem& sys = *m_system;
   const Config& cfg = sys.config();
-  if (m_probes) {
+  const bool is_last = step == m_rt.settings().steps;
+  const bool is_probe_step = t >= m_next_probe_time * (1 - 1e-12) || is_last;
+  if (is_probe_step) m_next_probe_time = t + cfg.probe_interval;
+  if (m_probes && is_probe_step) {
     m_row.clear();
     for (const auto& p : cfg.probes) {
       const auto x = sys.positions(p.fiber);
@@ -179,7 +185,7 @@ void FiberProgram::output(long step, double t, bool fields) {
     }
     m_probes->write(t, m_row);
   }
-  if (m_loads) {
+  if (m_loads && is_probe_step) {
     m_row.clear();
     for (int e : m_load_ends) {
       const EndLoad l = e % 2 == 0 ? sys.root_load(e / 2) : sys.tip_load(e / 2);

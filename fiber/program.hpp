@@ -40,6 +40,7 @@ class FiberProgram : public fsi::FiberPort {
   std::vector<double> m_row, m_ext, m_geometry, m_tension, m_curvature, m_work;
   std::vector<EndPose> m_poses;
   double m_max_stretch = 0;
+  double m_next_probe_time = 0;
   long m_written_step = -1;
 };
 

@@ -119,6 +119,7 @@ struct Config {
   int tension_iterations = 8;        // Newton iterations at most (1 = a single linear solve)
   double stretch_limit = 1e-4;       // health: max | |X_s| - 1 | that stops the run
   std::vector<ProbeSpec> probes;
+  double probe_interval = 0;         // time between rows of the probe and load files; 0 = every step
   std::string file;                  // scene file, for messages
 };
 
