@@ -337,6 +337,46 @@ void Solver::update_prescribed(double t) {
   }
 }
 
+// The prescribed displacements at t (or load factor) become a pending increment: the first
+// Newton iteration carries it through the linearised system, K_ff du_f = R_f - K_fp du_p, so
+// that the free nodes follow the moved boundary instead of meeting it as a jump (which can
+// invert the elements next to it).
+bool Solver::prepare_prescribed(double t) {
+  const bool statics = m_model.settings.analysis == Analysis::statics;
+  bool any = false;
+  for (auto& bp : m_bodies) {
+    Body& B = *bp;
+    B.dirichlet_step.assign(B.u.size(), 0.0);
+    if (!B.is_elastic()) continue;
+    std::vector<double> target(B.u);
+    for (const auto& p : B.prescribed) {
+      if (p.constraint < 0) continue;
+      const auto& con = B.spec.constraints[p.constraint];
+      target[p.dof] = con.type == Constraint::Type::displacement
+                          ? con.displacement[p.component] * (statics ? t : con.time(t))
+                          : 0.0;
+    }
+    for (const auto& p : B.prescribed)
+      if (p.follow >= 0) target[p.dof] = target[p.follow];
+    for (const auto& p : B.prescribed) {
+      B.dirichlet_step[p.dof] = target[p.dof] - B.u[p.dof];
+      if (B.dirichlet_step[p.dof] != 0) any = true;
+    }
+  }
+  m_dirichlet_pending = any;
+  return any;
+}
+
+void Solver::apply_prescribed_step() {
+  for (auto& bp : m_bodies) {
+    Body& B = *bp;
+    if (!B.is_elastic()) continue;
+    for (const auto& p : B.prescribed) B.u[p.dof] += B.dirichlet_step[p.dof];
+    B.sync_positions();
+  }
+  m_dirichlet_pending = false;
+}
+
 void Solver::update_rigid(double t) {
   for (auto& bp : m_bodies) {
     Body& B = *bp;
@@ -445,7 +485,28 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix,
             for (int c = 0; c < 3; ++c)
               for (int i = 0; i < 2; ++i) ke[6 * (2 * a + i) + 2 * c + i] += c0 * rho * me[a][c];
       }
+      if (with_matrix && m_dirichlet_pending) {
+        double dp[6];
+        bool moved = false;
+        for (int c = 0; c < 6; ++c) {
+          dp[c] = B.dirichlet_step[2 * t[c / 2] + c % 2];
+          moved = moved || dp[c] != 0;
+        }
+        if (moved)
+          for (int rr = 0; rr < 6; ++rr) {
+            double f = 0;
+            for (int c = 0; c < 6; ++c) f += ke[6 * rr + c] * dp[c];
+            r[2 * t[rr / 2] + rr % 2] -= f;
+          }
+      }
       if (with_matrix) {
+        // Round-off floor of the residual: |K| |u| (a residual cannot be resolved below eps of
+        // the element forces that cancel in it).
+        for (int rr = 0; rr < 6; ++rr) {
+          double f = 0;
+          for (int c = 0; c < 6; ++c) f += std::abs(ke[6 * rr + c]) * std::abs(B.u[2 * t[c / 2] + c % 2]);
+          absm[2 * t[rr / 2] + rr % 2] += f;
+        }
         const auto& map = B.kmap[e];
         for (int k = 0; k < 36; ++k)
           if (map[k] >= 0) values[map[k]] += ke[k];
@@ -628,8 +689,10 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
           cand.push_back(static_cast<int>(&s - slots.data()));
       }
     }
-    // Rows of B = dg/dx on the free equations.
+    // Rows of B = dg/dx on the free equations; a pending prescribed increment moves the gaps
+    // by its own part, B_p du_p.
     std::vector<std::vector<std::pair<int, double>>> rows(cand.size());
+    std::vector<double> gap_shift(cand.size(), 0.0);
     for (std::size_t k = 0; k < cand.size(); ++k) {
       const ContactSlot& s = slots[cand[k]];
       auto add = [&](int body, int node, double w) {
@@ -637,6 +700,8 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
         for (int i = 0; i < 2; ++i) {
           const int e = B.eq[2 * node + i];
           if (e >= 0) rows[k].push_back({e, w * s.normal[i]});
+          else if (m_dirichlet_pending && B.is_elastic())
+            gap_shift[k] += w * s.normal[i] * B.dirichlet_step[2 * node + i];
         }
       };
       add(s.slave_body, s.slave_node, 1.0);
@@ -654,8 +719,8 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
     // Converged: below tolerance, or stalled at round-off after at least one solve; no
     // penetration and every active constraint closed.
     const bool small = rn <= rep.tolerance;
-    const bool stalled = it > 0 && rn > 0.5 * previous && rn <= 1e-13 * m_roundoff_scale;
-    if ((small || stalled) && worst_gap <= gap_tol) {
+    const bool stalled = it > 0 && rn > 0.5 * previous && rn <= 1e-12 * m_roundoff_scale;
+    if ((small || stalled) && worst_gap <= gap_tol && !m_dirichlet_pending) {
       rep.converged = true;
       break;
     }
@@ -673,7 +738,7 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
       Eigen::VectorXd q(nc);
       for (int k = 0; k < nc; ++k) {
         for (const auto& [e, w] : rows[k]) Bt(e, k) += w;
-        q[k] = slots[cand[k]].gap;
+        q[k] = slots[cand[k]].gap + gap_shift[k];
       }
       const Eigen::MatrixXd Y = m_ldlt.solve(Bt);
       const Eigen::MatrixXd S = Bt.transpose() * Y;
@@ -690,6 +755,7 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
       }
     }
     rep.solve_seconds += seconds_since(t0);
+    if (m_dirichlet_pending) apply_prescribed_step();
     for (auto& bp : m_bodies) {
       Body& B = *bp;
       if (!B.is_elastic()) continue;
@@ -754,7 +820,7 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
     bp->v_old = bp->v;
   }
   update_rigid(t1);
-  update_prescribed(t1);
+  prepare_prescribed(t1);
   m_contact_force_factor = 0.5;
   StepReport rep = newton(4 / (dt * dt), dt, t1, external, when);
   // Newmark velocity from the positions, v^(n+1) = 2 (x^(n+1) - x^n) / dt - v^n (the trapezoidal
@@ -782,7 +848,7 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
 
 StepReport Solver::solve_static_step(double factor) {
   const std::string when = fmt::format("load factor {:.6g}", factor);
-  update_prescribed(factor);
+  prepare_prescribed(factor);
   m_contact_force_factor = 1.0;
   for (auto& bp : m_bodies) {
     bp->u_old = bp->u;

@@ -112,6 +112,8 @@ class Solver {
   void number_equations();
   void build_pattern();
   void update_prescribed(double t);
+  bool prepare_prescribed(double t);
+  void apply_prescribed_step();
   void update_rigid(double t);
   // Assembles R (free equations) and, when with_matrix, K_eff = K_T + c0 M into m_matrix.
   // Returns the first inverted element as (body, element) or (-1, -1).
@@ -137,6 +139,7 @@ class Solver {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> m_ldlt;
   ContactSet m_contact;
   double m_contact_force_factor = 1;  // physical contact force / multiplier (1/2 in Newmark)
+  bool m_dirichlet_pending = false;   // a prescribed increment awaits the first Newton solve
 };
 
 }  // namespace solid
