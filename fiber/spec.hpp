@@ -96,7 +96,8 @@ struct FiberSpec {
 };
 
 // Fiber-fiber repulsion (paper Eq. 11-12): W_r = k / (2 r^2) for r < cutoff between markers of
-// different fibers; F_r = -dW_r/dX is a force per unit length.
+// different fibers; F_r = -dW_r/dX is a force per unit length (step.cpp says how it is applied
+// so that action = reaction).
 struct RepulsionSpec {
   bool is_enabled = false;
   double stiffness = 0;  // k [force length^2 / length]

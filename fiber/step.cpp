@@ -285,9 +285,13 @@ void FiberSystem::prescribed_load(int k, double h, std::span<const double> exter
   m_root_acc[k].moment += moment;
 }
 
-// Fiber-fiber repulsion at X^n (paper Eq. 11-12), per unit length at each marker:
-//   F_r,i = sum_j k (X_i - X_j) / |X_i - X_j|^4  over markers j of other fibers with
-//   |X_i - X_j| < cutoff (= -dW_r/dX_i with W_r = k / (2 |X_i - X_j|^2)).
+// Fiber-fiber repulsion at X^n (paper Eq. 11-12). Between markers i and j of different fibers
+// closer than the cut-off, W_r = k / (2 |X_i - X_j|^2) gives the force per unit length
+//   F_r,i = k (X_i - X_j) / |X_i - X_j|^4  (= -dW_r/dX_i),
+// summed over j. On the markers it acts as the force F_r,i sqrt(l_i l_j) (l = ds w, the marker's
+// arclength) and -F_r,i sqrt(l_i l_j) on j: the per-unit-length force of Eq. 11 between interior
+// markers of equal ds, with action = reaction for every pair (ends and unequal ds included).
+// Stored per unit length of marker i: F_r,i sqrt(l_j / l_i).
 void FiberSystem::repulsion_forces() {
   const auto& rep = m_config.repulsion;
   if (!rep.is_enabled) return;
@@ -300,10 +304,12 @@ void FiberSystem::repulsion_forces() {
   };
   m_cells.for_each_pair(m_x, rep.cutoff, fiber_end, [&](std::size_t i, std::size_t j, double dx, double dy, double r2) {
     const double c = kr / (r2 * r2);
-    m_repulsion[2 * i] += c * dx;
-    m_repulsion[2 * i + 1] += c * dy;
-    m_repulsion[2 * j] -= c * dx;
-    m_repulsion[2 * j + 1] -= c * dy;
+    const double ci = c * std::sqrt(m_weight[j] / m_weight[i]);
+    const double cj = c * std::sqrt(m_weight[i] / m_weight[j]);
+    m_repulsion[2 * i] += ci * dx;
+    m_repulsion[2 * i + 1] += ci * dy;
+    m_repulsion[2 * j] -= cj * dx;
+    m_repulsion[2 * j + 1] -= cj * dy;
   });
 }
 
