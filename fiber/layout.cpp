@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "error.hpp"
@@ -78,7 +79,6 @@ double EndLaw::angle_at(double t) const {
 FiberSystem::FiberSystem(Config config) : m_config(std::move(config)) {
   const auto& cfg = m_config;
   const std::string in = where(cfg);
-  if (cfg.fibers.empty()) throw fsi::InputError("fiber: the scene defines no fiber ([[fiber.fiber]])" + in);
   if (cfg.substeps < 1) throw fsi::InputError(fmt::format("fiber.substeps must be >= 1, got {}{}", cfg.substeps, in));
 
   // Sizes and offsets.
@@ -214,8 +214,9 @@ FiberSystem::FiberSystem(Config config) : m_config(std::move(config)) {
 
   // Overlap: markers of different fibers closer than the repulsion cut-off (the repulsion
   // potential is singular) or, without repulsion, practically coincident.
-  double min_ds = m_fibers[0].ds;
+  double min_ds = std::numeric_limits<double>::infinity();
   for (const auto& s : m_fibers) min_ds = std::min(min_ds, s.ds);
+  if (m_fibers.empty()) return;
   const double gap = cfg.repulsion.is_enabled ? cfg.repulsion.cutoff : 1e-3 * min_ds;
   m_cells.build(m_x, gap);
   m_cells.for_each_pair(m_x, gap, [&](std::size_t i, std::size_t j, double, double, double r2) {

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace fiber {
 
@@ -27,6 +28,7 @@ FiberProgram::FiberProgram(fsi::Runtime& rt)
   m_system.emplace(read_checked(rt));
   const FiberSystem& sys = *m_system;
   const Config& cfg = sys.config();
+  if (sys.fiber_count() == 0) std::fprintf(stderr, "[fiber] note: the scene defines no fiber ([[fiber.fiber]])\n");
 
   // Layout: one polyline per fiber, drawn as 2-node segments.
   std::vector<std::size_t> nodes;

@@ -118,9 +118,9 @@ position = [0, 0]
   // a typo
   e = error_of([&] { read("typo.toml", with(base, "length = 1\nsegments = 8\nbendng = 2\n")); });
   CHECK_THAT(e, Contains("unknown key 'fiber.fiber[0].bendng'") && Contains("did you mean 'bending'"));
-  // no fiber at all
-  e = error_of([&] { read("none.toml", "[fiber]\ngravity = [0, -1]\n"); });
-  CHECK_THAT(e, Contains("[fiber]: defines no fiber"));
+  // no fiber at all: a scene without fibers, not an error
+  CHECK(read("none.toml", "[fiber]\ngravity = [0, -1]\n").fibers.empty());
+  CHECK_NOTHROW(FiberSystem(read("none.toml", "[fiber]\n")));
   // a probe on a fiber that does not exist
   e = error_of([&] {
     read("probe.toml", with(base, "length = 1\nsegments = 8\n[[fiber.probe]]\nname = \"p\"\nfiber = \"b\"\ns = 0.5\n"));

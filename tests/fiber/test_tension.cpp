@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "error.hpp"
 #include "helpers.hpp"
 
 using namespace fiber;
@@ -106,4 +107,32 @@ TEST_CASE("a free fiber falls with exactly g and carries no tension", "[fiber][t
     CHECK(x[2 * i + 1] == Approx(x0[2 * i + 1] - 0.5 * 2.0 * t * t).margin(1e-11));
   }
   for (double T : sys.segment_tension(0)) CHECK(std::abs(T) < 1e-9);
+}
+
+TEST_CASE("health: supports pulled apart beyond the fiber's length stop the run with the stretch",
+          "[fiber][tension]") {
+  // A slack chain between two hinges whose tip support moves away: once the supports are
+  // farther apart than the length, no tension can hold it.
+  FiberSpec f = make_fiber(1.0, 16, 1.0, 0.0, {0, 0}, -0.6);
+  f.shape = ShapeKind::arc;
+  f.curvature = 1.2;
+  f.root.kind = EndKind::hinged;
+  f.tip.kind = EndKind::hinged;
+  f.tip.velocity = {0.5, 0.0};
+  Config c = one_fiber(f);
+  FiberSystem sys(c);
+  const auto x = sys.positions(0);
+  const double chord = std::hypot(x[32] - x[0], x[33] - x[1]);
+  REQUIRE(chord < 1.0);
+  const double dt = 1e-3;
+  std::string message;
+  try {
+    for (int n = 0; n < 20000; ++n) sys.advance(dt);
+  } catch (const fsi::Error& e) {
+    message = e.what();
+  }
+  INFO("stopped at t = " << sys.time() << " with: " << message);
+  CHECK_THAT(message, Catch::Matchers::Contains("stretch") && Catch::Matchers::Contains("fiber.stretch_limit"));
+  // it stopped once the supports were about a length apart, not before
+  CHECK(chord + 0.5 * sys.time() > 0.99);
 }
