@@ -5,8 +5,10 @@
              [--cwd DIR] [--file-exists F]... -- COMMAND...
 
 Passes when the exit code is 0 (or non-zero with --expect-fail), every --regex matches the
-combined stdout+stderr, no --absent pattern matches, the job ended within --within seconds, and
-every --file-exists path exists afterwards. The output is printed in any case.
+combined stdout+stderr, no --absent pattern matches, the job ended within --within seconds,
+every --file-exists path exists afterwards, and for every --csv-max-abs FILE:COLUMN_REGEX:LIMIT
+the largest |value| of the matching columns of that CSV (header line, then numbers) is at most
+LIMIT. The output is printed in any case.
 """
 import argparse
 import os
@@ -25,6 +27,7 @@ def main():
     p.add_argument("--timeout", type=float, default=120)
     p.add_argument("--cwd", default=None)
     p.add_argument("--file-exists", action="append", default=[])
+    p.add_argument("--csv-max-abs", action="append", default=[])
     p.add_argument("command", nargs=argparse.REMAINDER)
     a = p.parse_args()
     cmd = a.command[1:] if a.command and a.command[0] == "--" else a.command
@@ -60,6 +63,26 @@ def main():
         path = os.path.join(a.cwd or ".", f)
         if not os.path.exists(path):
             problems.append(f"missing output file {path}")
+    for spec in a.csv_max_abs:
+        fname, col_rx, limit = spec.rsplit(":", 2)
+        path = os.path.join(a.cwd or ".", fname)
+        if not os.path.exists(path):
+            problems.append(f"missing CSV file {path}")
+            continue
+        with open(path) as f:
+            header = f.readline().strip().split(",")
+            cols = [k for k, h in enumerate(header) if re.fullmatch(col_rx, h)]
+            if not cols:
+                problems.append(f"no column of {path} matches /{col_rx}/")
+                continue
+            worst, rows = 0.0, 0
+            for line in f:
+                vals = line.strip().split(",")
+                worst = max([worst] + [abs(float(vals[k])) for k in cols])
+                rows += 1
+        print(f"{fname}: max |{col_rx}| = {worst:.3e} over {rows} rows (limit {limit})")
+        if rows == 0 or not worst <= float(limit):
+            problems.append(f"{fname}: max |{col_rx}| = {worst:.3e} over {rows} rows, limit {limit}")
     for pr in problems:
         print("FAIL:", pr)
     return 1 if problems else 0
