@@ -33,6 +33,7 @@ struct PhaseTimes {
   double tension = 0;  // the tension equation (Newton on |X_s| = 1)
   double update = 0;   // position update, end loads, health checks
   long steps = 0;
+  long tension_solves = 0;  // tridiagonal solves (Newton steps), summed over fibers and sub-steps
 };
 
 // Explicit bending limit of one fiber: the scheme (bending at X* = 2X^n - X^(n-1)) is stable for
@@ -107,6 +108,7 @@ class FiberSystem {
   // Kinetic energy of fiber k from the last step's velocity (X^n - X^(n-1)) / h.
   double kinetic_energy(int k) const;
   const PhaseTimes& phase_times() const { return m_times; }
+  void reset_phase_times() { m_times = PhaseTimes{}; }
 
  private:
   struct Fiber {

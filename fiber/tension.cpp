@@ -95,6 +95,7 @@ void FiberSystem::solve_tension(int k) {
     ++it;
   }
   s.tension_iterations = it;
+  m_times.tension_solves += it;
   std::copy(xn, xn + 2 * (n + 1), m_x_new.data() + 2 * o);
 }
 
