@@ -15,7 +15,7 @@ namespace solid {
 
 namespace {
 
-// y = (K - sigma M)^-1 x through one sparse LDL^T (lower triangles stored).
+// y = (K - sigma M)^-1 x through one sparse factorisation (lower triangles stored).
 class ShiftInvertOp {
  public:
   using Scalar = double;
@@ -24,20 +24,22 @@ class ShiftInvertOp {
   Eigen::Index rows() const { return m_K.rows(); }
   Eigen::Index cols() const { return m_K.cols(); }
   void set_shift(double sigma) {
-    m_ldlt.compute(m_K - sigma * m_M);
-    if (m_ldlt.info() != Eigen::Success)
-      fsi::fail("solid: modes: K - sigma M could not be factorised for sigma = {}", sigma);
+    const Eigen::SparseMatrix<double> A = m_K - sigma * m_M;
+    m_solver.analyze(A);
+    if (!m_solver.factorize(A))
+      fsi::fail("solid: modes: K - sigma M is singular for sigma = {} (a body without constraint "
+                "has zero-frequency modes; give a negative shift)", sigma);
   }
   void perform_op(const double* x_in, double* y_out) const {
     Eigen::Map<const Eigen::VectorXd> x(x_in, m_K.rows());
     Eigen::Map<Eigen::VectorXd> y(y_out, m_K.rows());
-    y = m_ldlt.solve(x);
+    y = m_solver.solve(Eigen::VectorXd(x));
   }
 
  private:
   const Eigen::SparseMatrix<double>& m_K;
   const Eigen::SparseMatrix<double>& m_M;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> m_ldlt;
+  LinearSolver m_solver;
 };
 
 }  // namespace

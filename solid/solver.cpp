@@ -39,7 +39,8 @@ double TimeFunction::operator()(double t) const {
 
 Solver::~Solver() = default;
 
-Solver::Solver(Model model) : m_model(std::move(model)) {
+Solver::Solver(Model model, LinearSolver::Backend backend)
+    : m_model(std::move(model)), m_linear(backend) {
   const auto& s = m_model.settings;
   if (m_model.bodies.empty()) throw fsi::InputError("solid: the model has no body");
   if (!(s.newton_tolerance > 0)) throw fsi::InputError("solid: newton tolerance must be > 0");
@@ -315,7 +316,7 @@ void Solver::build_pattern() {
     }
   }
   m_residual.setZero(m_neq);
-  m_ldlt.analyzePattern(m_matrix);
+  m_linear.analyze(m_matrix);
 }
 
 void Solver::update_prescribed(double t) {
@@ -528,13 +529,7 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix,
 }
 
 void Solver::factorize(const std::string& when) {
-  m_ldlt.factorize(m_matrix);
-  bool singular = m_ldlt.info() != Eigen::Success;
-  if (!singular) {
-    const Eigen::VectorXd D = m_ldlt.vectorD().cwiseAbs();
-    singular = !(D.minCoeff() > 1e-13 * D.maxCoeff());
-  }
-  if (singular)
+  if (!m_linear.factorize(m_matrix))
     fsi::fail("solid: the stiffness matrix is singular at {}: a body is not held against rigid "
               "motion (no constraint, no mass, no contact) or an element has collapsed", when);
 }
@@ -731,7 +726,7 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
     factorize(when);
     rep.factor_seconds += seconds_since(t0);
     t0 = clock::now();
-    dx = m_ldlt.solve(m_residual);
+    dx = m_linear.solve(m_residual);
     if (!cand.empty()) {
       const int nc = static_cast<int>(cand.size());
       Eigen::MatrixXd Bt = Eigen::MatrixXd::Zero(m_neq, nc);
@@ -740,7 +735,7 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
         for (const auto& [e, w] : rows[k]) Bt(e, k) += w;
         q[k] = slots[cand[k]].gap + gap_shift[k];
       }
-      const Eigen::MatrixXd Y = m_ldlt.solve(Bt);
+      const Eigen::MatrixXd Y = m_linear.solve(Bt);
       const Eigen::MatrixXd S = Bt.transpose() * Y;
       q += Bt.transpose() * dx;
       const Eigen::VectorXd lambda = solve_contact_lcp(S, q, gap_tol);

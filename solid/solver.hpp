@@ -8,7 +8,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-#include <Eigen/SparseCholesky>
 
 #include <memory>
 #include <string>
@@ -16,6 +15,7 @@
 
 #include "contact.hpp"
 #include "element.hpp"
+#include "linear_solver.hpp"
 #include "model.hpp"
 
 namespace solid {
@@ -41,7 +41,7 @@ class Solver {
   // Validates the model (throws fsi::InputError for bad input), numbers the equations, builds
   // the sparse pattern and its symbolic factorisation, and sets the initial state (reference
   // configuration, initial velocities).
-  explicit Solver(Model model);
+  explicit Solver(Model model, LinearSolver::Backend backend = LinearSolver::Backend::automatic);
   ~Solver();
 
   const Model& model() const { return m_model; }
@@ -50,6 +50,7 @@ class Solver {
   int num_equations() const { return m_neq; }
   double time() const { return m_time; }
   long step() const { return m_step; }
+  std::string linear_backend() const { return m_linear.backend(); }
 
   // One Newmark step of size dt. external[b] (may be null or empty per body) holds nodal forces
   // on body b, layout (f0x, f0y, f1x, ...), force ON the solid, held over the step; they are
@@ -136,7 +137,7 @@ class Solver {
   double m_roundoff_scale = 0;  // the same with the terms of c0 M u: the round-off floor
   Eigen::SparseMatrix<double> m_matrix;  // lower triangle of K_eff on the free equations
   Eigen::VectorXd m_residual;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> m_ldlt;
+  LinearSolver m_linear;
   ContactSet m_contact;
   double m_contact_force_factor = 1;  // physical contact force / multiplier (1/2 in Newmark)
   bool m_dirichlet_pending = false;   // a prescribed increment awaits the first Newton solve
