@@ -25,6 +25,7 @@ GhostRule quadratic_rule(double w0, double w1) {
 }  // namespace
 
 Boundaries::Boundaries(const Grid& g, const std::array<SideBc, 4>& bc) : m_g(g), m_bc(bc) {
+  for (int s = 0; s < 4; ++s) m_speed[s] = bc[s].type == BcType::wall ? bc[s].wall_speed(0.0) : 0.0;
   for (int s = 0; s < 4; ++s) {
     const Axis& ax = g.axis(s / 2);
     const bool hi = s % 2;
@@ -92,6 +93,7 @@ void Boundaries::advance_normal(Field& u, Field& v, double t, double dt) {
     const double sign_in = hi ? -1.0 : 1.0;
     if (bc.type == BcType::wall || bc.type == BcType::slip) {
       for (int k = 0; k < o.n(); ++k) at(nf, a, b, k) = 0;
+      m_speed[s] = bc.type == BcType::wall ? bc.wall_speed(t) : 0.0;
     } else if (bc.type == BcType::inflow) {
       for (int k = 0; k < o.n(); ++k) at(nf, a, b, k) = sign_in * inflow(s, o.centre(k), t);
     } else {  // outflow
@@ -162,7 +164,7 @@ void Boundaries::fill_ghosts(Field& u, Field& v) const {
       if (r.is_data) continue;
       const bool hi = s % 2;
       const int g = hi ? nx : -1, q0 = hi ? nx - 1 : 0, q1 = hi ? nx - 2 : 1;
-      const double data = m_bc[s].velocity * (m_bc[s].type == BcType::wall ? 1.0 : 0.0);
+      const double data = m_speed[s];
       for (int j = 0; j <= ny; ++j) v(g, j) = r.ga * v(q0, j) + r.gb * v(q1, j) + r.gc * data;
     }
   }
@@ -182,7 +184,7 @@ void Boundaries::fill_ghosts(Field& u, Field& v) const {
       if (r.is_data) continue;
       const bool hi = s % 2;
       const int g = hi ? ny : -1, q0 = hi ? ny - 1 : 0, q1 = hi ? ny - 2 : 1;
-      const double data = m_bc[s].velocity * (m_bc[s].type == BcType::wall ? 1.0 : 0.0);
+      const double data = m_speed[s];
       for (int i = -1; i <= nx + 1; ++i) u(i, g) = r.ga * u(i, q0) + r.gb * u(i, q1) + r.gc * data;
     }
   }

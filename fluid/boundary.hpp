@@ -29,7 +29,8 @@ class Boundaries {
 
   // Inflow velocity into the domain at tangential coordinate s, time t.
   double inflow(int side, double s, double t) const;
-  // Normal-velocity boundary faces at time t: walls 0, inflow profile. Outflow faces: convected
+  // Normal-velocity boundary faces at time t: walls 0 (and their tangential speed at t for the
+  // ghosts), inflow profile. Outflow faces: convected
   // from their current values over dt, then all outflow faces are shifted by one constant so
   // that the net flux through the boundary is zero. Tangential outflow ghosts are convected too.
   void advance_normal(Field& u, Field& v, double t, double dt);
@@ -46,6 +47,7 @@ class Boundaries {
   std::array<GhostRule, 4> m_rule;
   bool m_has_outflow = false;
   std::array<std::vector<double>, 4> m_prev;  // Orlanski: last step's first interior line
+  std::array<double, 4> m_speed{};            // walls: tangential speed at the last advance_normal
 };
 
 }  // namespace fluid

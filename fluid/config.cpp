@@ -127,7 +127,7 @@ void validate(const Config& c, double dt) {
   for (int s = 0; s < 4; ++s) {
     const SideBc& b = c.bc[s];
     if (b.type == BcType::inflow) umax = std::max(umax, std::abs(b.mean) * (b.profile == Profile::parabolic ? 1.5 : 1.0));
-    if (b.type == BcType::wall) umax = std::max(umax, std::abs(b.velocity));
+    if (b.type == BcType::wall) umax = std::max(umax, std::abs(b.velocity) + std::abs(b.amplitude));
   }
   const double hmin = std::min(min_width(c.x), min_width(c.y));
   const double cfl = umax * dt / hmin;
@@ -148,6 +148,9 @@ SideBc read_side(const fsi::SceneTable& t) {
   if (type == "wall") {
     b.type = BcType::wall;
     b.velocity = t.number("velocity", 0.0);
+    b.amplitude = t.number("amplitude", 0.0);
+    b.omega = t.number("omega", 0.0);
+    b.phase_angle = t.number("phase", 0.0);
   }
   if (type == "slip") b.type = BcType::slip;
   if (type == "inflow") {

@@ -2,6 +2,8 @@
 // directly by tests and drivers. fluid/README.md documents every key with an example scene.
 #pragma once
 
+#include <cmath>
+
 #include <array>
 #include <string>
 #include <vector>
@@ -24,7 +26,11 @@ enum class Phase { bulk, orlanski };
 
 struct SideBc {
   BcType type = BcType::wall;
-  double velocity = 0;  // wall: tangential speed along +x (bottom/top) or +y (left/right)
+  double velocity = 0;  // wall: tangential speed along +x (bottom/top) or +y (left/right) ...
+  double amplitude = 0;  // ... plus amplitude sin(omega t + phase_angle): an oscillating wall
+  double omega = 0;
+  double phase_angle = 0;
+  double wall_speed(double t) const { return velocity + amplitude * std::sin(omega * t + phase_angle); }
   Profile profile = Profile::parabolic;  // inflow: profile shape ...
   double mean = 0;                       // ... mean speed into the domain ...
   Ramp ramp = Ramp::none;                // ... and its start-up in time:

@@ -131,7 +131,7 @@ std::vector<double> wall_shear(const Solver& s, Side side, std::vector<double>* 
   const double s0 = 0.5 * w0, s1 = w0 + 0.5 * w1;
   const double d0 = s1 / (s0 * (s1 - s0)), d1 = -s0 / (s1 * (s1 - s0)), dw = -(d0 + d1);
   const SideBc& bc = s.boundaries().side(side);
-  const double wall = bc.type == BcType::wall ? bc.velocity : 0.0;
+  const double wall = bc.type == BcType::wall ? bc.wall_speed(s.time()) : 0.0;
   const int q0 = hi ? n - 1 : 0, q1 = hi ? n - 2 : 1;
   const int m = o.periodic() ? o.n() : o.n() + 1;
   std::vector<double> tau(m);
