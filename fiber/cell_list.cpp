@@ -1,4 +1,5 @@
-// Spatial-hash cell list: see cell_list.hpp.
+// Spatial-hash cell list (see cell_list.hpp): counting sort of the points into hash buckets of
+// square cells, rebuilt every step without allocation once the largest count has been seen.
 #include "cell_list.hpp"
 
 namespace fiber {

@@ -1,4 +1,5 @@
-// [fiber] scene table -> fiber::Config (see config.hpp and README.md for the keys).
+// [fiber] scene table -> fiber::Config (see config.hpp, and README.md for the keys): rows of
+// fibers expanded, end and motion laws in radians, probes resolved to fiber indices.
 #include "config.hpp"
 
 #include <fmt/format.h>

@@ -1,4 +1,4 @@
-"""Helpers of the fiber validation cases: run the `fiber` program on a scene, read its probes,
+"""Shared code of the fiber validation cases: run the `fiber` program on a scene, read its probes,
 support loads, HDF5 output and report, record metrics as {value, reference, error, tolerance,
 pass} in summary.json. Environment (set by `./fsi validate`): FSI_ROOT, FSI_BIN, FSI_OUT."""
 import json

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "helpers.hpp"
+#include "fixtures.hpp"
 
 using namespace fiber;
 using namespace fiber::test;

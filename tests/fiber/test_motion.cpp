@@ -6,7 +6,7 @@
 #include <numbers>
 
 #include "error.hpp"
-#include "helpers.hpp"
+#include "fixtures.hpp"
 
 using namespace fiber;
 using namespace fiber::test;

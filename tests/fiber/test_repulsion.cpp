@@ -7,7 +7,7 @@
 #include <random>
 #include <set>
 
-#include "helpers.hpp"
+#include "fixtures.hpp"
 
 using namespace fiber;
 using namespace fiber::test;

@@ -1,4 +1,5 @@
-// Small helpers shared by the fiber unit tests: fiber specs, mode shapes, zero crossings.
+// What the fiber unit tests share: fiber specs, Euler-Bernoulli cantilever modes, zero crossings
+// and periods of sampled signals.
 #pragma once
 
 #include <cmath>
