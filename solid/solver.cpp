@@ -661,7 +661,12 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
       if (inverted.first >= 0)
         fail_health("element turned inside out (det F <= 0) during Newton", inverted.first,
                     inverted.second, when);
-      fsi::fail("solid: non-finite residual at {}", when);
+      for (const auto& bp : m_bodies)
+        for (std::size_t d = 0; d < bp->r.size(); ++d)
+          if (bp->is_elastic() && bp->eq[d] >= 0 && !std::isfinite(bp->r[d]))
+            fsi::fail("solid: non-finite residual (NaN or Inf) in body '{}' node {} at {}",
+                      bp->spec.name, d / 2, when);
+      fsi::fail("solid: non-finite residual (NaN or Inf) at {}", when);
     }
 
     // Contact: geometry at the current iterate; the slots that are active (lambda > 0) or
