@@ -127,8 +127,9 @@ void FeedbackIB::interpolate(const std::vector<double>& x, std::vector<double>& 
 void FeedbackIB::spread(const std::vector<double>& x, const std::vector<double>& F, double ds) {
   std::int32_t idx[16];
   double w[16];
-  const double scale = -ds / (m_hx * m_hy);
+  const std::size_t last = x.size() - 2;
   for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
+    const double scale = -(m == 0 || m == last ? 0.5 * ds : ds) / (m_hx * m_hy);
     for (int c = 0; c < 2; ++c) {
       Family& f = c == 0 ? m_u : m_v;
       kernel(f, x[m], x[m + 1], idx, w);

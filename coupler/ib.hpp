@@ -40,8 +40,9 @@ class FeedbackIB {
   void interpolate(const std::vector<double>& x, std::vector<double>& u) const;
 
   // The force per unit volume on the fluid from forces per unit length F on the markers of one
-  // fiber of spacing ds: f(x_f) = −Σ_m F_m ds φ(..)φ(..)/(h_x h_y), accumulated into `u`/`v`
-  // (dense per family, indexed by face) and the touched faces recorded.
+  // fiber of spacing ds: f(x_f) = −Σ_m F_m w_m φ(..)φ(..)/(h_x h_y), with the marker's arclength
+  // w_m = ds inside and ds/2 at the two ends (the weights the fiber integrates its loads with, so
+  // that action = reaction), accumulated per face and the touched faces recorded.
   void spread(const std::vector<double>& x, const std::vector<double>& F, double ds);
   // The accumulated spread force as sparse face lists (sorted), then cleared.
   void take_spread(proto::FaceForce& u, proto::FaceForce& v);
