@@ -88,6 +88,9 @@ fsi::proto::FiberLayout FiberProgram::layout() const {
     one.root_x = f.root.point.x();
     one.root_y = f.root.point.y();
     one.line_density = f.is_prescribed() ? 0.0 : f.density;
+    one.root_x = f.root.point.x();
+    one.root_y = f.root.point.y();
+    one.line_density = f.is_prescribed() ? 0.0 : f.density;
     l.fibers.push_back(one);
   }
   return l;
