@@ -96,6 +96,19 @@ void SolidProgram::write_modes() {
       m_h5.write(fmt::format("{}/mode_{}", body_group(m_cfg.model.bodies[b].name), k + 1), v3,
                  {sh.size() / 2, 3});
     }
+  // One side file per body that shows the modes as a series whose "time" is the frequency.
+  for (int b = 0; b < m_solver->num_bodies(); ++b) {
+    if (m_solver->kind(b) != BodyKind::elastic) continue;
+    const std::string& name = m_cfg.model.bodies[b].name;
+    const std::string g = body_group(name);
+    const Mesh& m = m_solver->mesh(b);
+    fsi::XdmfWriter x(m_rt.out_dir() / fmt::format("solid_{}_modes.xdmf", name), m_rt.out_dir() / "solid.h5",
+                      fsi::XdmfTriangles{g + "/triangles", m.triangles.size(), std::size_t(m.num_nodes()),
+                                         g + "/x_ref"},
+                      name + " modes");
+    for (std::size_t k = 0; k < f.size(); ++k)
+      x.add_step(f[k], {{"mode_shape", fsi::XdmfCenter::node, fmt::format("{}/mode_{}", g, k + 1), 3}});
+  }
   for (std::size_t k = 0; k < f.size(); ++k)
     fmt::print("[solid] mode {}: omega = {:.8g}, f = {:.8g}\n", k + 1, m_modes.omega[k], f[k]);
 }

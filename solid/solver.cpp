@@ -87,6 +87,8 @@ void Solver::setup_body(int index) {
   B.X = mesh.x;
   B.x = mesh.x;
   B.u.assign(2 * nn, 0.0);
+  B.abs_q.assign(2 * nn, 0.0);
+  B.abs_floor.assign(2 * nn, 0.0);
   B.v.assign(2 * nn, 0.0);
   B.ma.assign(2 * nn, 0.0);
   B.f_ext.assign(2 * nn, 0.0);
@@ -402,17 +404,21 @@ void Solver::update_rigid(double t) {
 }
 
 std::vector<double> Solver::scene_loads(int b, double t) const {
-  const Body& B = *m_bodies[b];
-  std::vector<double> f(B.X.size(), 0.0);
-  if (!B.is_elastic()) return f;
+  std::vector<double> f(m_bodies[b]->X.size(), 0.0);
+  add_scene_loads(*m_bodies[b], t, f);
+  return f;
+}
+
+// F(t) = (gravity + sum_k f_k(t) load_k), or factor * (gravity + sum_k load_k) in statics.
+void Solver::add_scene_loads(const Body& B, double t, std::vector<double>& f) const {
+  if (!B.is_elastic()) return;
   const bool statics = m_model.settings.analysis == Analysis::statics;
   const double scale = statics ? t : 1.0;
-  for (std::size_t d = 0; d < f.size(); ++d) f[d] = scale * B.gravity[d];
+  for (std::size_t d = 0; d < f.size(); ++d) f[d] += scale * B.gravity[d];
   for (std::size_t k = 0; k < B.load_dofs.size(); ++k) {
     const double s = statics ? t : B.spec.loads[k].time(t);
     for (const auto& [dof, c] : B.load_dofs[k]) f[dof] += s * c;
   }
-  return f;
 }
 
 // Residual on the free equations, for Newmark (c0 = 4 / dt^2) or statics (c0 = 0):
@@ -434,7 +440,8 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix,
     Body& B = *bp;
     if (!B.is_elastic()) continue;
     const Mesh& mesh = B.spec.mesh;
-    B.f_ext = scene_loads(B.index, time_or_factor);
+    std::fill(B.f_ext.begin(), B.f_ext.end(), 0.0);
+    add_scene_loads(B, time_or_factor, B.f_ext);
     if (external && static_cast<int>(external->size()) > B.index && !(*external)[B.index].empty()) {
       const auto& fe = (*external)[B.index];
       if (fe.size() != B.f_ext.size())
@@ -445,7 +452,10 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix,
     std::fill(B.q.begin(), B.q.end(), 0.0);
     std::vector<double>& r = B.r;
     for (std::size_t d = 0; d < r.size(); ++d) r[d] = B.f_ext[d] + (dynamic ? B.ma[d] : 0.0);
-    std::vector<double> absq(r.size(), 0.0), absm(r.size(), 0.0);
+    std::vector<double>& absq = B.abs_q;  // |element forces| and |K| |u|: scales of R
+    std::vector<double>& absm = B.abs_floor;
+    std::fill(absq.begin(), absq.end(), 0.0);
+    std::fill(absm.begin(), absm.end(), 0.0);
     for (int e = 0; e < mesh.num_triangles(); ++e) {
       const auto& t = mesh.triangles[e];
       double fe[6], ke[36];

@@ -116,6 +116,7 @@ class Solver {
   bool prepare_prescribed(double t);
   void apply_prescribed_step();
   void update_rigid(double t);
+  void add_scene_loads(const Body& body, double t, std::vector<double>& f) const;
   // Assembles R (free equations) and, when with_matrix, K_eff = K_T + c0 M into m_matrix.
   // Returns the first inverted element as (body, element) or (-1, -1).
   std::pair<int, int> assemble(double c0, double dt, bool with_matrix, double load_factor,

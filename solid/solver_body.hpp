@@ -37,6 +37,7 @@ struct Solver::Body {
   std::vector<double> contact;            // contact force on the nodes (physical)
   std::vector<double> det_f;              // per element, last assembly
   std::vector<double> dirichlet_step;     // pending increment of the prescribed dofs
+  std::vector<double> abs_q, abs_floor;   // assembly scratch: scales of the residual
   // Loads: constant part (gravity) and per-load nodal coefficients.
   std::vector<double> gravity;
   std::vector<std::vector<std::pair<int, double>>> load_dofs;  // per spec.loads entry
