@@ -91,6 +91,7 @@ void Solver::setup_body(int index) {
   B.abs_floor.assign(2 * nn, 0.0);
   B.v.assign(2 * nn, 0.0);
   B.ma.assign(2 * nn, 0.0);
+  B.f_cpl.assign(2 * nn, 0.0);
   B.f_ext.assign(2 * nn, 0.0);
   B.q.assign(2 * nn, 0.0);
   B.r.assign(2 * nn, 0.0);
@@ -279,6 +280,14 @@ void Solver::number_equations() {
         throw fsi::InputError(fmt::format("solid: body '{}' has every node prescribed", b->spec.name));
 }
 
+int Solver::matrix_index(int row, int col) const {
+  const int* inner = m_matrix.innerIndexPtr();
+  const int* begin = inner + m_matrix.outerIndexPtr()[col];
+  const int* end = inner + m_matrix.outerIndexPtr()[col + 1];
+  const int* it = std::lower_bound(begin, end, row);
+  return it != end && *it == row ? static_cast<int>(it - inner) : -1;
+}
+
 void Solver::build_pattern() {
   using Triplet = Eigen::Triplet<double>;
   std::vector<Triplet> trip;
@@ -293,16 +302,14 @@ void Solver::build_pattern() {
         }
   }
   for (int i = 0; i < m_neq; ++i) trip.emplace_back(i, i, 0.0);
+  for (const auto& [r, c] : m_contact_entries) trip.emplace_back(r, c, 0.0);
   m_matrix.resize(m_neq, m_neq);
   m_matrix.setFromTriplets(trip.begin(), trip.end());
   m_matrix.makeCompressed();
   auto index_of = [&](int row, int col) {
-    const int* inner = m_matrix.innerIndexPtr();
-    const int* begin = inner + m_matrix.outerIndexPtr()[col];
-    const int* end = inner + m_matrix.outerIndexPtr()[col + 1];
-    const int* it = std::lower_bound(begin, end, row);
-    FSI_ASSERT(it != end && *it == row);
-    return static_cast<int>(it - inner);
+    const int k = matrix_index(row, col);
+    FSI_ASSERT(k >= 0);
+    return k;
   };
   for (auto& bp : m_bodies) {
     Body& B = *bp;
@@ -447,11 +454,23 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix,
       if (fe.size() != B.f_ext.size())
         fsi::fail("solid: external forces for body '{}' have {} values, expected {}", B.spec.name,
                   fe.size(), B.f_ext.size());
-      for (std::size_t d = 0; d < fe.size(); ++d) B.f_ext[d] += fe[d];
+      for (std::size_t d = 0; d < fe.size(); ++d) B.f_cpl[d] = fe[d];
+    } else {
+      std::fill(B.f_cpl.begin(), B.f_cpl.end(), 0.0);
     }
     std::fill(B.q.begin(), B.q.end(), 0.0);
     std::vector<double>& r = B.r;
-    for (std::size_t d = 0; d < r.size(); ++d) r[d] = B.f_ext[d] + (dynamic ? B.ma[d] : 0.0);
+    // The coupling force is the reaction of the fluid's velocity correction over this step: an
+    // impulse F_c dt within the step, like the contact acceleration of the paper's Eq. 13-14
+    // (x^(n+1) = ... + dt^2/2 a_c, v^(n+1) = ... + dt a_c). In the trapezoidal residual
+    // (4/dt^2) M (x^(n+1) - x^n - dt v^n) - M a^n = F^(n+1) - Q^(n+1) + 2 F_c it enters twice,
+    // and it stays out of the stored M a (the next step does not average it in again): the
+    // solid receives the whole impulse in the step the fluid lost it, so momentum balances step
+    // by step. Averaging it over two steps delays the reaction and pumps energy into the solid's
+    // element-scale modes. Massless dofs (rho_s = rho_f) are quasi-static: F - Q + F_c = 0.
+    for (std::size_t d = 0; d < r.size(); ++d)
+      r[d] = B.f_ext[d] +
+             (dynamic ? B.ma[d] + (B.mass_row[d] > 0 ? 2.0 : 1.0) * B.f_cpl[d] : B.f_cpl[d]);
     std::vector<double>& absq = B.abs_q;  // |element forces| and |K| |u|: scales of R
     std::vector<double>& absm = B.abs_floor;
     std::fill(absq.begin(), absq.end(), 0.0);
@@ -527,7 +546,7 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix,
       r[d] -= B.q[d];
       if (B.eq[d] >= 0) {
         m_residual[B.eq[d]] += r[d];
-        const double s = std::abs(B.f_ext[d]) + absq[d] + (dynamic ? std::abs(B.ma[d]) : 0.0);
+        const double s = std::abs(B.f_ext[d]) + 2 * std::abs(B.f_cpl[d]) + absq[d] + (dynamic ? std::abs(B.ma[d]) : 0.0);
         scale2 += s * s;
         floor2 += (s + absm[d]) * (s + absm[d]);
       }
@@ -721,6 +740,48 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
       }
       if (s.active)
         for (const auto& [e, w] : rows[k]) R[e] += s.lambda * w;
+    }
+    // Contact curvature: -lambda d2g/dx2 for every active slot on an elastic segment. It
+    // couples the slave node to the master's nodes, entries the element pattern lacks: the
+    // pattern grows once (re-analysed) the first time a pair of nodes meets.
+    if (n_active > 0) {
+      bool grow = false;
+      std::vector<std::array<int, 6>> slot_eqs;
+      std::vector<int> slot_index;
+      for (std::size_t k = 0; k < slots.size(); ++k) {
+        const ContactSlot& s = slots[k];
+        if (!s.active || s.master_body < 0 || s.m1 < 0 || !m_bodies[s.master_body]->is_elastic()) continue;
+        const Body& S = *m_bodies[s.slave_body];
+        const Body& M = *m_bodies[s.master_body];
+        const std::array<int, 6> eqs{S.eq[2 * s.slave_node], S.eq[2 * s.slave_node + 1], M.eq[2 * s.m0],
+                                     M.eq[2 * s.m0 + 1], M.eq[2 * s.m1], M.eq[2 * s.m1 + 1]};
+        for (int a : eqs)
+          for (int b : eqs)
+            if (a >= 0 && b >= 0 && a >= b && matrix_index(a, b) < 0) {
+              m_contact_entries.insert({a, b});
+              grow = true;
+            }
+        slot_eqs.push_back(eqs);
+        slot_index.push_back(static_cast<int>(k));
+      }
+      if (grow) {
+        build_pattern();
+        assemble(c0, dt, true, time_or_factor, external);
+      }
+      double* values = m_matrix.valuePtr();
+      for (std::size_t q = 0; q < slot_eqs.size(); ++q) {
+        const ContactSlot& s = slots[slot_index[q]];
+        const auto& xs = m_bodies[s.slave_body]->x;
+        const auto& xm = m_bodies[s.master_body]->x;
+        double H[36];
+        segment_gap_hessian({xs[2 * s.slave_node], xs[2 * s.slave_node + 1]}, {xm[2 * s.m0], xm[2 * s.m0 + 1]},
+                            {xm[2 * s.m1], xm[2 * s.m1 + 1]}, H);
+        const auto& eqs = slot_eqs[q];
+        for (int r = 0; r < 6; ++r)
+          for (int c = 0; c < 6; ++c)
+            if (eqs[r] >= 0 && eqs[c] >= 0 && eqs[r] >= eqs[c])
+              values[matrix_index(eqs[r], eqs[c])] -= s.lambda * H[6 * r + c];
+      }
     }
     const double rn = R.norm();
     rep.residuals.push_back(rn);

@@ -25,6 +25,7 @@ struct Solver::Body {
   std::vector<ElementGeometry> geo;
   std::vector<int> material;       // per element
   std::vector<double> rho_inertia;  // per element: rho_s - rho_f
+  std::vector<double> f_cpl;        // coupling force of the current step: an impulse over it
   std::vector<double> mass_row;     // per dof: row sum of M (zero: massless dof)
   std::vector<int> eq;              // per dof: equation, -1 when prescribed
   std::vector<Prescribed> prescribed;
