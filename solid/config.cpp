@@ -2,6 +2,8 @@
 // a "did you mean"), with each bad value reported against its key and file.
 #include "config.hpp"
 
+#include <cstdio>
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -266,7 +268,8 @@ Config read_config(const fsi::SceneTable& s, double fluid_density) {
   if (c.initial_mode > 0) c.initial_mode_speed = s.positive("initial_mode_speed");
 
   const auto bodies = s.tables("body");
-  if (bodies.empty()) s.fail_table("needs at least one [[solid.body]]");
+  // No body: a coupled scene may carry an empty [solid] (the program then only keeps the clock).
+  if (bodies.empty()) std::fprintf(stderr, "[solid] note: [solid] has no [[solid.body]]: no solid to advance\n");
   for (const auto& b : bodies) {
     MeshQuality q;
     c.model.bodies.push_back(read_body(b, q));

@@ -21,6 +21,28 @@ bool inside_surface(const Mesh& mesh, const std::vector<double>& x, double px, d
   return inside;
 }
 
+void segment_gap_hessian(const Vec2& xs, const Vec2& x1, const Vec2& x2, double H[36]) {
+  const double ex = x2[0] - x1[0], ey = x2[1] - x1[1];
+  const double l = std::hypot(ex, ey);
+  const double t[2] = {ex / l, ey / l}, n[2] = {ey / l, -ex / l};
+  const double dx = xs[0] - x1[0], dy = xs[1] - x1[1];
+  const double g = dx * n[0] + dy * n[1];
+  const double xi = (dx * t[0] + dy * t[1]) / l;
+  double hde[2][2], hee[2][2];
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) {
+      hde[i][j] = -t[i] * n[j] / l;
+      hee[i][j] = xi * (n[i] * t[j] + t[i] * n[j]) / l - g * n[i] * n[j] / (l * l);
+    }
+  const double cd[3] = {1, -1, 0}, ce[3] = {0, -1, 1};
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j)
+          H[6 * (2 * a + i) + 2 * b + j] =
+              cd[a] * ce[b] * hde[i][j] + ce[a] * cd[b] * hde[j][i] + ce[a] * ce[b] * hee[i][j];
+}
+
 void ContactSet::setup(const std::vector<const Mesh*>& meshes, const std::vector<BodyKind>& kinds,
                        const std::vector<ContactPair>& pairs,
                        const std::vector<ContactPlane>& planes) {

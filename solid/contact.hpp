@@ -55,6 +55,13 @@ class ContactSet {
   std::vector<ContactSlot> m_slots;
 };
 
+// Second derivative of the gap to a segment, g = (x_s - x_1) . n with n = (e_y, -e_x) / l,
+// e = x_2 - x_1, l = |e|, t = e / l, and xi the projection parameter: with d = x_s - x_1,
+//   d2g/dd2 = 0,  d2g/dd de = -t n^T / l,  d2g/de2 = xi (n t^T + t n^T) / l - g n n^T / l^2,
+// mapped to the nodes (s, 1, 2) through dd/dx = (I, -I, 0), de/dx = (0, -I, I). Output: 6 x 6
+// row-major, dof order (s_x, s_y, 1_x, 1_y, 2_x, 2_y). Enters the tangent as -lambda H.
+void segment_gap_hessian(const Vec2& xs, const Vec2& x1, const Vec2& x2, double H[36]);
+
 // True when point p is inside the closed surface loops (edges a -> b) of a mesh at positions x.
 bool inside_surface(const Mesh& mesh, const std::vector<double>& x, double px, double py);
 

@@ -10,6 +10,8 @@
 #include <Eigen/SparseCore>
 
 #include <memory>
+#include <set>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -112,6 +114,7 @@ class Solver {
   void setup_body(int index);
   void number_equations();
   void build_pattern();
+  int matrix_index(int row, int col) const;  // position in m_matrix's values, -1 if absent
   void update_prescribed(double t);
   bool prepare_prescribed(double t);
   void apply_prescribed_step();
@@ -137,6 +140,7 @@ class Solver {
   double m_force_scale = 0;  // norm of |F_ext| + |Q| + |inertia| from the last assembly
   double m_roundoff_scale = 0;  // the same with the terms of c0 M u: the round-off floor
   Eigen::SparseMatrix<double> m_matrix;  // lower triangle of K_eff on the free equations
+  std::set<std::pair<int, int>> m_contact_entries;  // extra (row, col) entries contact needs
   Eigen::VectorXd m_residual;
   LinearSolver m_linear;
   ContactSet m_contact;

@@ -57,7 +57,11 @@ TEST_CASE("two blocks pressed together: no penetration, contact force = applied 
         INFO(material_model_name(mm) << " slave body " << slave << " two-way " << two_way);
         Solver s(two_blocks(0.02, slave, two_way, mm));
         const auto reps = s.solve_static();
-        for (const auto& r : reps) CHECK(r.converged);
+        // The contact curvature in the tangent keeps Newton quadratic: a handful of iterations.
+        for (const auto& r : reps) {
+          CHECK(r.converged);
+          CHECK(r.iterations <= 7);
+        }
         const Vec2 load = s.reaction(1, "top");      // what pushes the punch down
         const Vec2 fc_punch = s.total_contact_force(1);
         const Vec2 fc_base = s.total_contact_force(0);
@@ -140,4 +144,31 @@ TEST_CASE("a block dropped on a rigid plane bounces without penetration or energ
   const double scale = mass * 10 * 0.05;
   CHECK(max_energy <= e0 + 1e-9 * scale);
   CHECK(max_vy_after > 0.1 * -min_vy);  // it comes back up
+}
+
+TEST_CASE("the segment gap Hessian is the derivative of the gap gradient", "[contact]") {
+  // g(x) = (x_s - x_1) . n(x_2 - x_1); gradient (n, -(1 - xi) n, -xi n).
+  auto gradient = [](const double* x, double* grad) {
+    const double ex = x[4] - x[2], ey = x[5] - x[3], l = std::hypot(ex, ey);
+    const double n[2] = {ey / l, -ex / l};
+    const double xi = ((x[0] - x[2]) * ex + (x[1] - x[3]) * ey) / (l * l);
+    for (int i = 0; i < 2; ++i) {
+      grad[i] = n[i];
+      grad[2 + i] = -(1 - xi) * n[i];
+      grad[4 + i] = -xi * n[i];
+    }
+  };
+  double x[6] = {0.4, 0.13, 0.0, 0.1, 1.1, 0.25};  // slave slightly off the segment (g != 0)
+  double H[36];
+  segment_gap_hessian({x[0], x[1]}, {x[2], x[3]}, {x[4], x[5]}, H);
+  const double h = 1e-6;
+  for (int c = 0; c < 6; ++c) {
+    double gp[6], gm[6];
+    x[c] += h;
+    gradient(x, gp);
+    x[c] -= 2 * h;
+    gradient(x, gm);
+    x[c] += h;
+    for (int r = 0; r < 6; ++r) CHECK((gp[r] - gm[r]) / (2 * h) == Approx(H[6 * r + c]).margin(1e-7));
+  }
 }
