@@ -111,3 +111,31 @@ TEST_CASE("advance with coupling forces; a body with rho_s = rho_f follows them 
   h2.advance(1e-3, f2);
   CHECK(h2.positions(0)[2 * 62 + 1] - 0.1 > 1e-5);
 }
+
+TEST_CASE("a rigid body follows its prescribed motion and carries no equations", "[coupling][rigid]") {
+  Model model = bar(0);
+  RigidMotion& m = model.bodies[1].motion;
+  m.center = {-0.1, 0.05};
+  m.velocity = {0.2, 0};
+  m.omega = 0.5;
+  Solver s(model);
+  CouplingHook hook(s);
+  CHECK(hook.geometry(1).moving);
+  const int neq = s.num_equations();
+  std::vector<std::vector<double>> forces(2);
+  for (int k = 0; k < 4; ++k) hook.advance(0.25, forces);
+  CHECK(s.num_equations() == neq);
+  // After t = 1: rotated by 0.5 rad about the centre, which moved by (0.2, 0).
+  const auto& X = s.mesh(1).x;
+  const auto& x = hook.positions(1);
+  const auto& v = hook.velocities(1);
+  const double c = std::cos(0.5), sn = std::sin(0.5);
+  for (int n = 0; n < s.mesh(1).num_nodes(); ++n) {
+    const double rx = X[2 * n] + 0.1, ry = X[2 * n + 1] - 0.05;
+    CHECK(x[2 * n] == Approx(-0.1 + 0.2 + c * rx - sn * ry).margin(1e-14));
+    CHECK(x[2 * n + 1] == Approx(0.05 + sn * rx + c * ry).margin(1e-14));
+    // v = velocity + omega x (x - c)
+    CHECK(v[2 * n] == Approx(0.2 - 0.5 * (sn * rx + c * ry)).margin(1e-14));
+    CHECK(v[2 * n + 1] == Approx(0.5 * (c * rx - sn * ry)).margin(1e-14));
+  }
+}
