@@ -16,8 +16,8 @@ namespace solid {
 namespace {
 
 // Gmsh keeps global state: initialise for one read, always finalise.
-struct GmshSession {
-  explicit GmshSession(const GmshOptions& options) {
+struct GmshScope {
+  explicit GmshScope(const GmshOptions& options) {
     std::vector<std::string> args{"gmsh"};
     for (const auto& [name, value] : options.parameters) {
       args.push_back("-setnumber");
@@ -30,7 +30,7 @@ struct GmshSession {
     gmsh::option::setNumber("General.Terminal", 0);
     gmsh::option::setNumber("General.Verbosity", 1);
   }
-  ~GmshSession() { gmsh::finalize(); }
+  ~GmshScope() { gmsh::finalize(); }
 };
 
 std::string last_gmsh_error() {
@@ -62,7 +62,7 @@ Mesh read_gmsh(const std::filesystem::path& file, const GmshOptions& options,
           "{}: mesh file '{}' is not a Gmsh mesh (no $MeshFormat header)", key, name));
   }
 
-  GmshSession session(options);
+  GmshScope scope(options);
   try {
     gmsh::open(name);
     if (ext == ".geo") {

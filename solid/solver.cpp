@@ -42,7 +42,6 @@ Solver::~Solver() = default;
 Solver::Solver(Model model, LinearSolver::Backend backend)
     : m_model(std::move(model)), m_linear(backend) {
   const auto& s = m_model.settings;
-  if (m_model.bodies.empty()) throw fsi::InputError("solid: the model has no body");
   if (!(s.newton_tolerance > 0)) throw fsi::InputError("solid: newton tolerance must be > 0");
   if (s.newton_max_iterations < 1) throw fsi::InputError("solid: newton iterations must be >= 1");
   if (s.analysis == Analysis::statics && s.load_steps < 1)
@@ -325,7 +324,7 @@ void Solver::build_pattern() {
     }
   }
   m_residual.setZero(m_neq);
-  m_linear.analyze(m_matrix);
+  if (m_neq > 0) m_linear.analyze(m_matrix);
 }
 
 void Solver::update_prescribed(double t) {
@@ -873,6 +872,13 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
 
 StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* external) {
   if (!(dt > 0)) fsi::fail("solid: time step must be > 0, got {}", dt);
+  if (m_bodies.empty()) {  // a scene without bodies: only the clock moves
+    m_time += dt;
+    m_step++;
+    StepReport none;
+    none.converged = true;
+    return none;
+  }
   if (m_model.settings.analysis != Analysis::dynamic)
     fsi::fail("solid: advance() needs a dynamic analysis");
   const double t1 = m_time + dt;

@@ -1,4 +1,4 @@
-"""Helpers of the solid validation cases: run the `solid` program on a scene, read its output
+"""Shared code of the solid validation cases: run the `solid` program on a scene, read its output
 (HDF5 fields, probe and history CSV, summary.json), record metrics as {value, reference, error,
 tolerance, pass} in summary.json. Environment (set by `./fsi validate`): FSI_ROOT, FSI_BIN,
 FSI_OUT. `--short` selects the quick version that the test suite runs."""
