@@ -2,10 +2,9 @@
 // a "did you mean"), with each bad value reported against its key and file.
 #include "config.hpp"
 
-#include <cstdio>
-
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "gmsh_mesh.hpp"
@@ -45,12 +44,14 @@ std::vector<std::pair<std::string, double>> parse_parameters(const fsi::SceneTab
     };
     if (trim(item).empty()) continue;
     if (eq == std::string::npos)
-      t.fail(key, fmt::format("must be \"name = value, ...\", got \"{}\" in \"{}\"", trim(item), text));
+      t.fail(key,
+             fmt::format("must be \"name = value, ...\", got \"{}\" in \"{}\"", trim(item), text));
     const std::string name = trim(item.substr(0, eq)), value = trim(item.substr(eq + 1));
     char* end = nullptr;
     const double v = std::strtod(value.c_str(), &end);
     if (name.empty() || value.empty() || *end != '\0')
-      t.fail(key, fmt::format("must be \"name = value, ...\", got \"{}\" in \"{}\"", trim(item), text));
+      t.fail(key,
+             fmt::format("must be \"name = value, ...\", got \"{}\" in \"{}\"", trim(item), text));
     out.push_back({name, v});
   }
   return out;
@@ -84,11 +85,13 @@ Material read_material(const fsi::SceneTable& t) {
     m.bulk = m.lambda + 2 * m.mu / 3;
     if (!(m.bulk > 0))
       t.fail("lame_lambda", fmt::format("must give a positive bulk modulus lambda + 2 mu / 3, got "
-                                        "{}", m.bulk));
+                                        "{}",
+                                        m.bulk));
   } else {
-    t.fail_table("give the elastic constants as one pair: youngs_modulus and poisson_ratio, "
-                 "shear_modulus and poisson_ratio, shear_modulus and bulk_modulus, or "
-                 "shear_modulus and lame_lambda");
+    t.fail_table(
+        "give the elastic constants as one pair: youngs_modulus and poisson_ratio, "
+        "shear_modulus and poisson_ratio, shear_modulus and bulk_modulus, or "
+        "shear_modulus and lame_lambda");
   }
   return m;
 }
@@ -119,7 +122,8 @@ Mesh read_mesh(const fsi::SceneTable& b, MeshQuality& quality) {
     if (cells.size() != 2 || cells[0] < 1 || cells[1] < 1 || cells[0] != std::floor(cells[0]) ||
         cells[1] != std::floor(cells[1]))
       r.fail("cells", "must be two integers >= 1, [nx, ny]");
-    const std::string d = r.choice("diagonals", {"criss-cross", "right", "left", "union-jack"}, "criss-cross");
+    const std::string d =
+        r.choice("diagonals", {"criss-cross", "right", "left", "union-jack"}, "criss-cross");
     const std::string region = r.string("region", "body");
     r.finish();
     mesh = rectangle_mesh(origin[0], origin[1], size[0], size[1], static_cast<int>(cells[0]),
@@ -185,7 +189,8 @@ BodySpec read_body(const fsi::SceneTable& b, MeshQuality& quality) {
   }
   for (std::size_t r = 0; r < set.size(); ++r)
     if (!set[r])
-      b.fail_table(fmt::format("region \"{}\" of mesh {} has no material", mesh.region_names[r], mesh.source));
+      b.fail_table(fmt::format("region \"{}\" of mesh {} has no material", mesh.region_names[r],
+                               mesh.source));
 
   for (const auto& t : b.tables("constraint")) {
     Constraint c;
@@ -216,13 +221,15 @@ BodySpec read_body(const fsi::SceneTable& b, MeshQuality& quality) {
   for (const auto& t : b.tables("load")) {
     Load l;
     if (t.has("traction") == t.has("force"))
-      t.fail_table("a load is either traction = [tx, ty] on a boundary or force = [fx, fy] at a point");
+      t.fail_table(
+          "a load is either traction = [tx, ty] on a boundary or force = [fx, fy] at a point");
     if (t.has("traction")) {
       l.type = Load::Type::traction;
       require_boundary(t, "boundary", mesh);
       l.boundary = t.string("boundary");
       if (mesh.boundaries.count(l.boundary) == 0)
-        t.fail("boundary", fmt::format("names \"{}\", a node set: a traction needs edges", l.boundary));
+        t.fail("boundary",
+               fmt::format("names \"{}\", a node set: a traction needs edges", l.boundary));
       l.value = t.vec2("traction");
     } else {
       l.type = Load::Type::point;
@@ -244,7 +251,8 @@ int body_named(const fsi::SceneTable& t, const std::string& key, const std::stri
     if (bodies[b].name == name) return static_cast<int>(b);
   std::vector<std::string> names;
   for (const auto& b : bodies) names.push_back(b.name);
-  t.fail(key, fmt::format("names body \"{}\", which does not exist (bodies: {})", name, fmt::join(names, ", ")));
+  t.fail(key, fmt::format("names body \"{}\", which does not exist (bodies: {})", name,
+                          fmt::join(names, ", ")));
 }
 
 }  // namespace
@@ -263,13 +271,16 @@ Config read_config(const fsi::SceneTable& s, double fluid_density) {
   c.modes = static_cast<int>(s.integer("modes", 0));
   if (c.modes < 0) s.fail("modes", fmt::format("must be >= 0, got {}", c.modes));
   c.initial_mode = static_cast<int>(s.integer("initial_mode", 0));
-  if (c.initial_mode < 0 || c.initial_mode > std::max(c.modes, 0) || (c.initial_mode > 0 && c.modes == 0))
-    s.fail("initial_mode", fmt::format("must be in [0, modes = {}], got {}", c.modes, c.initial_mode));
+  if (c.initial_mode < 0 || c.initial_mode > std::max(c.modes, 0) ||
+      (c.initial_mode > 0 && c.modes == 0))
+    s.fail("initial_mode",
+           fmt::format("must be in [0, modes = {}], got {}", c.modes, c.initial_mode));
   if (c.initial_mode > 0) c.initial_mode_speed = s.positive("initial_mode_speed");
 
   const auto bodies = s.tables("body");
   // No body: a coupled scene may carry an empty [solid] (the program then only keeps the clock).
-  if (bodies.empty()) std::fprintf(stderr, "[solid] note: [solid] has no [[solid.body]]: no solid to advance\n");
+  if (bodies.empty())
+    std::fprintf(stderr, "[solid] note: [solid] has no [[solid.body]]: no solid to advance\n");
   for (const auto& b : bodies) {
     MeshQuality q;
     c.model.bodies.push_back(read_body(b, q));
@@ -283,13 +294,14 @@ Config read_config(const fsi::SceneTable& s, double fluid_density) {
     for (std::size_t bi = 0; bi < bodies.size(); ++bi) {
       const auto& body = c.model.bodies[bi];
       if (body.kind != BodyKind::elastic) continue;
-      const bool held = std::any_of(body.constraints.begin(), body.constraints.end(), [](const Constraint& k) {
-        return k.type != Constraint::Type::periodic;
-      });
+      const bool held =
+          std::any_of(body.constraints.begin(), body.constraints.end(),
+                      [](const Constraint& k) { return k.type != Constraint::Type::periodic; });
       if (!held)
-        bodies[bi].fail_table(fmt::format("body \"{}\" has no fixed or displacement constraint: its "
-                                          "static solve (solid.analysis = \"static\") is singular",
-                                          body.name));
+        bodies[bi].fail_table(
+            fmt::format("body \"{}\" has no fixed or displacement constraint: its "
+                        "static solve (solid.analysis = \"static\") is singular",
+                        body.name));
     }
   // Probes, now that body indices are known.
   for (std::size_t bi = 0; bi < bodies.size(); ++bi)
@@ -299,8 +311,9 @@ Config read_config(const fsi::SceneTable& s, double fluid_density) {
       ps.body = static_cast<int>(bi);
       ps.point = p.vec2("point");
       if (locate(c.model.bodies[bi].mesh, ps.point[0], ps.point[1], 1e-6).triangle < 0)
-        p.fail("point", fmt::format("[{}, {}] is outside body \"{}\" in its reference configuration",
-                                    ps.point[0], ps.point[1], c.model.bodies[bi].name));
+        p.fail("point",
+               fmt::format("[{}, {}] is outside body \"{}\" in its reference configuration",
+                           ps.point[0], ps.point[1], c.model.bodies[bi].name));
       for (const auto& other : c.probes)
         if (other.name == ps.name) p.fail("name", fmt::format("\"{}\" names two probes", ps.name));
       p.finish();
@@ -314,7 +327,8 @@ Config read_config(const fsi::SceneTable& s, double fluid_density) {
     p.slave = body_named(t, "bodies", names[0], c.model.bodies);
     p.master = body_named(t, "bodies", names[1], c.model.bodies);
     if (p.slave == p.master) t.fail("bodies", "must name two different bodies");
-    if (c.model.bodies[p.slave].kind == BodyKind::rigid && c.model.bodies[p.master].kind == BodyKind::rigid)
+    if (c.model.bodies[p.slave].kind == BodyKind::rigid &&
+        c.model.bodies[p.master].kind == BodyKind::rigid)
       t.fail("bodies", "names two rigid bodies: one of them must be elastic");
     p.two_way = t.boolean("two_way", true);
     // A rigid body only ever provides the surface.
@@ -330,7 +344,8 @@ Config read_config(const fsi::SceneTable& s, double fluid_density) {
     if (!(len > 0)) t.fail("normal", "must be a non-zero vector");
     p.normal = {n[0] / len, n[1] / len};
     if (t.has("bodies")) {
-      for (const auto& name : t.strings("bodies")) p.bodies.push_back(body_named(t, "bodies", name, c.model.bodies));
+      for (const auto& name : t.strings("bodies"))
+        p.bodies.push_back(body_named(t, "bodies", name, c.model.bodies));
     } else {
       for (std::size_t b = 0; b < c.model.bodies.size(); ++b)
         if (c.model.bodies[b].kind == BodyKind::elastic) p.bodies.push_back(static_cast<int>(b));

@@ -3,7 +3,6 @@
 #include "solver.hpp"
 
 #include <Eigen/Dense>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -49,7 +48,8 @@ Solver::Solver(Model model, LinearSolver::Backend backend)
   for (std::size_t b = 0; b < m_model.bodies.size(); ++b) {
     for (std::size_t c = 0; c < b; ++c)
       if (m_model.bodies[b].name == m_model.bodies[c].name)
-        throw fsi::InputError(fmt::format("solid: two bodies are named '{}'", m_model.bodies[b].name));
+        throw fsi::InputError(
+            fmt::format("solid: two bodies are named '{}'", m_model.bodies[b].name));
     m_bodies.push_back(std::make_unique<Body>());
     m_bodies.back()->spec = m_model.bodies[b];
     m_bodies.back()->index = static_cast<int>(b);
@@ -114,7 +114,8 @@ void Solver::setup_body(int index) {
         (m.model == MaterialModel::neo_hookean ? !(m.bulk > 0) : !(m.lambda + m.mu > 0)))
       throw fsi::InputError(fmt::format(
           "solid: body '{}' region '{}': material constants must be positive (mu {}, lambda {}, "
-          "bulk {}, density {})", name, mesh.region_names[r], m.mu, m.lambda, m.bulk, m.density));
+          "bulk {}, density {})",
+          name, mesh.region_names[r], m.mu, m.lambda, m.bulk, m.density));
   }
   B.geo.resize(ne);
   B.material.resize(ne);
@@ -141,7 +142,8 @@ void Solver::setup_body(int index) {
       }
     if (B.spec.gravity)
       for (int a = 0; a < 3; ++a)
-        for (int i = 0; i < 2; ++i) B.gravity[2 * t[a] + i] += rho * B.geo[e].area / 3 * st.gravity[i];
+        for (int i = 0; i < 2; ++i)
+          B.gravity[2 * t[a] + i] += rho * B.geo[e].area / 3 * st.gravity[i];
   }
   // Scene loads as nodal coefficients.
   for (const auto& load : B.spec.loads) {
@@ -149,8 +151,10 @@ void Solver::setup_body(int index) {
     if (load.type == Load::Type::traction) {
       auto it = mesh.boundaries.find(load.boundary);
       if (it == mesh.boundaries.end())
-        throw fsi::InputError(fmt::format("solid: body '{}': load boundary '{}' is not an edge set "
-                                          "of mesh {}", name, load.boundary, mesh.source));
+        throw fsi::InputError(
+            fmt::format("solid: body '{}': load boundary '{}' is not an edge set "
+                        "of mesh {}",
+                        name, load.boundary, mesh.source));
       for (const auto& e : it->second) {
         const double len = std::hypot(mesh.x[2 * e[1]] - mesh.x[2 * e[0]],
                                       mesh.x[2 * e[1] + 1] - mesh.x[2 * e[0] + 1]);
@@ -161,7 +165,8 @@ void Solver::setup_body(int index) {
       int best = 0;
       double bd = std::numeric_limits<double>::max();
       for (int n = 0; n < nn; ++n) {
-        const double d = std::hypot(mesh.x[2 * n] - load.point[0], mesh.x[2 * n + 1] - load.point[1]);
+        const double d =
+            std::hypot(mesh.x[2 * n] - load.point[0], mesh.x[2 * n + 1] - load.point[1]);
         if (d < bd) {
           bd = d;
           best = n;
@@ -188,9 +193,9 @@ void Solver::number_equations() {
     for (std::size_t c = 0; c < B.spec.constraints.size(); ++c) {
       const auto& con = B.spec.constraints[c];
       if (!mesh.has_boundary(con.boundary))
-        throw fsi::InputError(fmt::format(
-            "solid: body '{}': constraint boundary '{}' is not in mesh {} (it has: {})", name,
-            con.boundary, mesh.source, fmt::join(mesh.boundary_names(), ", ")));
+        throw fsi::InputError(
+            fmt::format("solid: body '{}': constraint boundary '{}' is not in mesh {} (it has: {})",
+                        name, con.boundary, mesh.source, fmt::join(mesh.boundary_names(), ", ")));
       const auto nodes = mesh.boundary_nodes(con.boundary);
       if (con.type != Constraint::Type::periodic) {
         for (int n : nodes) {
@@ -200,9 +205,9 @@ void Solver::number_equations() {
         continue;
       }
       if (!mesh.has_boundary(con.partner))
-        throw fsi::InputError(fmt::format(
-            "solid: body '{}': periodic partner '{}' is not in mesh {} (it has: {})", name,
-            con.partner, mesh.source, fmt::join(mesh.boundary_names(), ", ")));
+        throw fsi::InputError(
+            fmt::format("solid: body '{}': periodic partner '{}' is not in mesh {} (it has: {})",
+                        name, con.partner, mesh.source, fmt::join(mesh.boundary_names(), ", ")));
       const auto partners = mesh.boundary_nodes(con.partner);
       Vec2 shift = con.shift;
       if (!con.shift_given) {
@@ -223,8 +228,9 @@ void Solver::number_equations() {
         if (match < 0)
           throw fsi::InputError(fmt::format(
               "solid: body '{}': periodic boundary '{}' node {} at ({}, {}) has no partner on '{}' "
-              "(shift ({}, {}))", name, con.boundary, n, mesh.x[2 * n], mesh.x[2 * n + 1],
-              con.partner, shift[0], shift[1]));
+              "(shift ({}, {}))",
+              name, con.boundary, n, mesh.x[2 * n], mesh.x[2 * n + 1], con.partner, shift[0],
+              shift[1]));
         if (match == n) continue;
         if (con.x) master[2 * n] = 2 * match;
         if (con.y) master[2 * n + 1] = 2 * match + 1;
@@ -236,7 +242,8 @@ void Solver::number_equations() {
       int r = d, guard = 0;
       while (by[r] < 0 && master[r] >= 0 && guard++ < ndof) r = master[r];
       if (guard >= ndof)
-        throw fsi::InputError(fmt::format("solid: body '{}': periodic constraints form a loop", name));
+        throw fsi::InputError(
+            fmt::format("solid: body '{}': periodic constraints form a loop", name));
       root[d] = r;
     }
     B.prescribed.clear();
@@ -269,14 +276,15 @@ void Solver::number_equations() {
         throw fsi::InputError(fmt::format(
             "solid: body '{}' has no constraint that holds it in {} ({} x and {} y components "
             "prescribed): a static solve is singular; fix or prescribe a boundary",
-            name, px == 0 && py == 0 ? "place" : (px == 0 ? "x" : (py == 0 ? "y" : "rotation")),
-            px, py));
+            name, px == 0 && py == 0 ? "place" : (px == 0 ? "x" : (py == 0 ? "y" : "rotation")), px,
+            py));
     }
   }
   if (m_neq == 0)
     for (const auto& b : m_bodies)
       if (b->is_elastic())
-        throw fsi::InputError(fmt::format("solid: body '{}' has every node prescribed", b->spec.name));
+        throw fsi::InputError(
+            fmt::format("solid: body '{}' has every node prescribed", b->spec.name));
 }
 
 int Solver::matrix_index(int row, int col) const {
@@ -432,8 +440,7 @@ void Solver::add_scene_loads(const Body& B, double t, std::vector<double>& f) co
 // with Q_a = sum_e A0 F S dN_a/dX (element.hpp) and, when with_matrix,
 //   K_eff = dQ/dx + c0 M  (material + geometric stiffness plus the Newmark mass term).
 // `time_or_factor` is t^(n+1) in dynamics and the load factor in statics.
-std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix,
-                                     double time_or_factor,
+std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, double time_or_factor,
                                      const std::vector<std::vector<double>>* external) {
   std::pair<int, int> inverted{-1, -1};
   if (with_matrix) std::fill_n(m_matrix.valuePtr(), m_matrix.nonZeros(), 0.0);
@@ -533,7 +540,8 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix,
         // the element forces that cancel in it).
         for (int rr = 0; rr < 6; ++rr) {
           double f = 0;
-          for (int c = 0; c < 6; ++c) f += std::abs(ke[6 * rr + c]) * std::abs(B.u[2 * t[c / 2] + c % 2]);
+          for (int c = 0; c < 6; ++c)
+            f += std::abs(ke[6 * rr + c]) * std::abs(B.u[2 * t[c / 2] + c % 2]);
           absm[2 * t[rr / 2] + rr % 2] += f;
         }
         const auto& map = B.kmap[e];
@@ -545,7 +553,8 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix,
       r[d] -= B.q[d];
       if (B.eq[d] >= 0) {
         m_residual[B.eq[d]] += r[d];
-        const double s = std::abs(B.f_ext[d]) + 2 * std::abs(B.f_cpl[d]) + absq[d] + (dynamic ? std::abs(B.ma[d]) : 0.0);
+        const double s = std::abs(B.f_ext[d]) + 2 * std::abs(B.f_cpl[d]) + absq[d] +
+                         (dynamic ? std::abs(B.ma[d]) : 0.0);
         scale2 += s * s;
         floor2 += (s + absm[d]) * (s + absm[d]);
       }
@@ -558,8 +567,10 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix,
 
 void Solver::factorize(const std::string& when) {
   if (!m_linear.factorize(m_matrix))
-    fsi::fail("solid: the stiffness matrix is singular at {}: a body is not held against rigid "
-              "motion (no constraint, no mass, no contact) or an element has collapsed", when);
+    fsi::fail(
+        "solid: the stiffness matrix is singular at {}: a body is not held against rigid "
+        "motion (no constraint, no mass, no contact) or an element has collapsed",
+        when);
 }
 
 void Solver::fail_health(const std::string& what, int body, int element,
@@ -727,7 +738,8 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
         const Body& B = *m_bodies[body];
         for (int i = 0; i < 2; ++i) {
           const int e = B.eq[2 * node + i];
-          if (e >= 0) rows[k].push_back({e, w * s.normal[i]});
+          if (e >= 0)
+            rows[k].push_back({e, w * s.normal[i]});
           else if (m_dirichlet_pending && B.is_elastic())
             gap_shift[k] += w * s.normal[i] * B.dirichlet_step[2 * node + i];
         }
@@ -749,11 +761,13 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
       std::vector<int> slot_index;
       for (std::size_t k = 0; k < slots.size(); ++k) {
         const ContactSlot& s = slots[k];
-        if (!s.active || s.master_body < 0 || s.m1 < 0 || !m_bodies[s.master_body]->is_elastic()) continue;
+        if (!s.active || s.master_body < 0 || s.m1 < 0 || !m_bodies[s.master_body]->is_elastic())
+          continue;
         const Body& S = *m_bodies[s.slave_body];
         const Body& M = *m_bodies[s.master_body];
-        const std::array<int, 6> eqs{S.eq[2 * s.slave_node], S.eq[2 * s.slave_node + 1], M.eq[2 * s.m0],
-                                     M.eq[2 * s.m0 + 1], M.eq[2 * s.m1], M.eq[2 * s.m1 + 1]};
+        const std::array<int, 6> eqs{S.eq[2 * s.slave_node], S.eq[2 * s.slave_node + 1],
+                                     M.eq[2 * s.m0],         M.eq[2 * s.m0 + 1],
+                                     M.eq[2 * s.m1],         M.eq[2 * s.m1 + 1]};
         for (int a : eqs)
           for (int b : eqs)
             if (a >= 0 && b >= 0 && a >= b && matrix_index(a, b) < 0) {
@@ -773,8 +787,8 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
         const auto& xs = m_bodies[s.slave_body]->x;
         const auto& xm = m_bodies[s.master_body]->x;
         double H[36];
-        segment_gap_hessian({xs[2 * s.slave_node], xs[2 * s.slave_node + 1]}, {xm[2 * s.m0], xm[2 * s.m0 + 1]},
-                            {xm[2 * s.m1], xm[2 * s.m1 + 1]}, H);
+        segment_gap_hessian({xs[2 * s.slave_node], xs[2 * s.slave_node + 1]},
+                            {xm[2 * s.m0], xm[2 * s.m0 + 1]}, {xm[2 * s.m1], xm[2 * s.m1 + 1]}, H);
         const auto& eqs = slot_eqs[q];
         for (int r = 0; r < 6; ++r)
           for (int c = 0; c < 6; ++c)
@@ -862,10 +876,11 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
           wb = bp->index;
           wn = static_cast<int>(d / 2);
         }
-    fsi::fail("solid: Newton did not converge in {} iterations at {}: residual {:.3e}, tolerance "
-              "{:.3e}, {} active contacts; largest residual in body '{}' node {}",
-              rep.iterations, when, rep.residuals.back(), rep.tolerance, rep.active_contacts,
-              wb >= 0 ? m_bodies[wb]->spec.name : "?", wn);
+    fsi::fail(
+        "solid: Newton did not converge in {} iterations at {}: residual {:.3e}, tolerance "
+        "{:.3e}, {} active contacts; largest residual in body '{}' node {}",
+        rep.iterations, when, rep.residuals.back(), rep.tolerance, rep.active_contacts,
+        wb >= 0 ? m_bodies[wb]->spec.name : "?", wn);
   }
   return rep;
 }
@@ -890,7 +905,8 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
     for (auto& bp : m_bodies)
       for (std::size_t d = 0; d < bp->ma.size(); ++d)
         bp->ma[d] = bp->is_elastic() && bp->mass_row[d] > 0 && bp->eq[d] >= 0
-                        ? bp->f_ext[d] - bp->q[d] : 0.0;
+                        ? bp->f_ext[d] - bp->q[d]
+                        : 0.0;
   }
   for (auto& bp : m_bodies) {
     bp->u_old = bp->u;
@@ -949,23 +965,35 @@ std::vector<StepReport> Solver::solve_static() {
   return reps;
 }
 
-const std::vector<double>& Solver::positions(int b) const { return m_bodies[b]->x; }
-const std::vector<double>& Solver::velocities(int b) const { return m_bodies[b]->v; }
-const Mesh& Solver::mesh(int b) const { return m_bodies[b]->spec.mesh; }
-BodyKind Solver::kind(int b) const { return m_bodies[b]->spec.kind; }
+const std::vector<double>& Solver::positions(int b) const {
+  return m_bodies[b]->x;
+}
+const std::vector<double>& Solver::velocities(int b) const {
+  return m_bodies[b]->v;
+}
+const Mesh& Solver::mesh(int b) const {
+  return m_bodies[b]->spec.mesh;
+}
+BodyKind Solver::kind(int b) const {
+  return m_bodies[b]->spec.kind;
+}
 
-std::vector<double> Solver::displacements(int b) const { return m_bodies[b]->u; }
+std::vector<double> Solver::displacements(int b) const {
+  return m_bodies[b]->u;
+}
 
 void Solver::set_velocity(int b, const std::vector<double>& v) {
   Body& B = *m_bodies[b];
-  if (v.size() != B.v.size()) fsi::fail("solid: set_velocity: wrong size for body '{}'", B.spec.name);
+  if (v.size() != B.v.size())
+    fsi::fail("solid: set_velocity: wrong size for body '{}'", B.spec.name);
   for (std::size_t d = 0; d < v.size(); ++d)
     if (B.eq[d] >= 0) B.v[d] = v[d];
 }
 
 void Solver::set_positions(int b, const std::vector<double>& x) {
   Body& B = *m_bodies[b];
-  if (x.size() != B.x.size()) fsi::fail("solid: set_positions: wrong size for body '{}'", B.spec.name);
+  if (x.size() != B.x.size())
+    fsi::fail("solid: set_positions: wrong size for body '{}'", B.spec.name);
   for (std::size_t d = 0; d < x.size(); ++d)
     if (B.eq[d] >= 0) B.u[d] = x[d] - B.X[d];
   B.sync_positions();
@@ -1010,7 +1038,8 @@ double Solver::load_potential() const {
   for (const auto& bp : m_bodies) {
     const Body& B = *bp;
     if (!B.is_elastic()) continue;
-    const auto f = scene_loads(B.index, m_model.settings.analysis == Analysis::statics ? 1.0 : m_time);
+    const auto f =
+        scene_loads(B.index, m_model.settings.analysis == Analysis::statics ? 1.0 : m_time);
     for (std::size_t d = 0; d < f.size(); ++d) p -= f[d] * B.u[d];
   }
   return p;
@@ -1042,14 +1071,17 @@ std::vector<double> Solver::element_von_mises(int b) const {
   return out;
 }
 
-std::vector<double> Solver::contact_forces(int b) const { return m_bodies[b]->contact; }
+std::vector<double> Solver::contact_forces(int b) const {
+  return m_bodies[b]->contact;
+}
 
 std::vector<double> Solver::contact_pressure(int b) const {
   const Body& B = *m_bodies[b];
   const Mesh& mesh = B.spec.mesh;
   std::vector<double> length(mesh.num_nodes(), 0.0), p(mesh.num_nodes(), 0.0);
   for (const auto& e : mesh.surface) {
-    const double l = std::hypot(B.x[2 * e[1]] - B.x[2 * e[0]], B.x[2 * e[1] + 1] - B.x[2 * e[0] + 1]);
+    const double l =
+        std::hypot(B.x[2 * e[1]] - B.x[2 * e[0]], B.x[2 * e[1] + 1] - B.x[2 * e[0] + 1]);
     length[e[0]] += l / 2;
     length[e[1]] += l / 2;
   }
