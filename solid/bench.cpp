@@ -29,18 +29,24 @@ int main(int argc, char** argv) {
   int steps = 20;
   LinearSolver::Backend backend = LinearSolver::Backend::automatic;
   for (int k = 1; k < argc; ++k) {
-    if (!std::strcmp(argv[k], "--out") && k + 1 < argc) out = argv[++k];
-    else if (!std::strcmp(argv[k], "--steps") && k + 1 < argc) steps = std::stoi(argv[++k]);
+    if (!std::strcmp(argv[k], "--out") && k + 1 < argc)
+      out = argv[++k];
+    else if (!std::strcmp(argv[k], "--steps") && k + 1 < argc)
+      steps = std::stoi(argv[++k]);
     else if (!std::strcmp(argv[k], "--backend") && k + 1 < argc)
-      backend = std::string(argv[++k]) == "cholmod" ? LinearSolver::Backend::cholmod : LinearSolver::Backend::ldlt;
+      backend = std::string(argv[++k]) == "cholmod" ? LinearSolver::Backend::cholmod
+                                                    : LinearSolver::Backend::ldlt;
   }
   nlohmann::json j;
-  j["case"] = "Turek-Hron bar (CSM1 material, gravity 2), Newmark dt = 0.005 from rest, criss-cross mesh";
+  j["case"] =
+      "Turek-Hron bar (CSM1 material, gravity 2), Newmark dt = 0.005 from rest, criss-cross mesh";
   j["steps_per_level"] = steps;
   j["levels"] = nlohmann::json::array();
-  fmt::print("{:>7} {:>7} {:>6} {:>6} | per Newton iteration [ms]: {:>8} {:>8} {:>8} {:>8} | {:>9} {:>9} | {:>8}\n",
-             "nodes", "eqs", "steps", "iters", "assembly", "factor", "solve", "total", "per step", "setup",
-             "ns/node");
+  fmt::print(
+      "{:>7} {:>7} {:>6} {:>6} | per Newton iteration [ms]: {:>8} {:>8} {:>8} {:>8} | {:>9} {:>9} "
+      "| {:>8}\n",
+      "nodes", "eqs", "steps", "iters", "assembly", "factor", "solve", "total", "per step", "setup",
+      "ns/node");
   std::vector<std::pair<double, double>> scaling;
   for (int level : {1, 2, 4}) {
     const int ny = 12 * level, nx = 300 * level;
@@ -51,9 +57,11 @@ int main(int argc, char** argv) {
     model.settings.gravity = {0, -2};
     BodySpec bar;
     bar.name = "bar";
-    bar.mesh = read_gmsh(std::filesystem::path(FSI_SOURCE_DIR) / "runs/turek-hron-csm/bar.geo", opt);
+    bar.mesh =
+        read_gmsh(std::filesystem::path(FSI_SOURCE_DIR) / "runs/turek-hron-csm/bar.geo", opt);
     const double t_mesh = now() - t0;
-    Material m = Material::from_young(MaterialModel::saint_venant_kirchhoff, 2 * 0.5e6 * 1.4, 0.4, 1000);
+    Material m =
+        Material::from_young(MaterialModel::saint_venant_kirchhoff, 2 * 0.5e6 * 1.4, 0.4, 1000);
     bar.materials = {m};
     Constraint c;
     c.boundary = "clamp";
@@ -83,22 +91,27 @@ int main(int argc, char** argv) {
     l["elements_across"] = ny;
     l["steps"] = steps;
     l["newton_iterations"] = iters;
-    l["per_iteration_s"] = {{"assembly", assembly / iters}, {"factorization", factor / iters},
-                            {"solve", solve / iters}, {"total", per_it}};
+    l["per_iteration_s"] = {{"assembly", assembly / iters},
+                            {"factorization", factor / iters},
+                            {"solve", solve / iters},
+                            {"total", per_it}};
     l["per_step_s"] = wall / steps;
     l["setup_s"] = t_setup;
     l["mesh_s"] = t_mesh;
     l["ns_per_node_iteration"] = 1e9 * per_it / nodes;
     j["levels"].push_back(l);
     scaling.push_back({std::log(double(nodes)), std::log(per_it)});
-    fmt::print("{:>7} {:>7} {:>6} {:>6} | {:>26} {:>8.2f} {:>8.2f} {:>8.2f} {:>8.2f} | {:>9.2f} {:>9.2f} | {:>8.0f}\n",
-               nodes, s.num_equations(), steps, iters, "", 1e3 * assembly / iters, 1e3 * factor / iters,
-               1e3 * solve / iters, 1e3 * per_it, 1e3 * wall / steps, 1e3 * t_setup, 1e9 * per_it / nodes);
+    fmt::print(
+        "{:>7} {:>7} {:>6} {:>6} | {:>26} {:>8.2f} {:>8.2f} {:>8.2f} {:>8.2f} | {:>9.2f} {:>9.2f} "
+        "| {:>8.0f}\n",
+        nodes, s.num_equations(), steps, iters, "", 1e3 * assembly / iters, 1e3 * factor / iters,
+        1e3 * solve / iters, 1e3 * per_it, 1e3 * wall / steps, 1e3 * t_setup, 1e9 * per_it / nodes);
   }
   // Growth exponent p of the time per iteration ~ nodes^p between the levels.
   nlohmann::json growth = nlohmann::json::array();
   for (std::size_t k = 1; k < scaling.size(); ++k)
-    growth.push_back((scaling[k].second - scaling[k - 1].second) / (scaling[k].first - scaling[k - 1].first));
+    growth.push_back((scaling[k].second - scaling[k - 1].second) /
+                     (scaling[k].first - scaling[k - 1].first));
   j["growth_exponent_per_iteration"] = growth;
   fmt::print("time per Newton iteration grows as nodes^p, p = {}\n", growth.dump());
   std::ofstream(out) << j.dump(2) << "\n";

@@ -26,9 +26,10 @@ BodyGeometry CouplingHook::geometry(int body) const {
   g.name = spec.name;
   g.kind = spec.kind;
   const auto& mo = spec.motion;
-  g.moving = spec.kind == BodyKind::rigid &&
-             (mo.velocity[0] != 0 || mo.velocity[1] != 0 || mo.omega != 0 ||
-              ((mo.amplitude[0] != 0 || mo.amplitude[1] != 0 || mo.angle != 0) && mo.frequency != 0));
+  g.moving =
+      spec.kind == BodyKind::rigid &&
+      (mo.velocity[0] != 0 || mo.velocity[1] != 0 || mo.omega != 0 ||
+       ((mo.amplitude[0] != 0 || mo.amplitude[1] != 0 || mo.angle != 0) && mo.frequency != 0));
   g.x_ref = m.x;
   g.triangles = m.triangles;
   g.surface = m.surface;
@@ -60,9 +61,11 @@ void CouplingHook::add_point_load(int body, int edge, double s, const Vec2& forc
   const auto& x = m_solver.positions(body);
   if (nodal.empty()) nodal.assign(x.size(), 0.0);
   if (nodal.size() != x.size())
-    fsi::fail("solid: point load: nodal force vector has {} values, expected {}", nodal.size(), x.size());
+    fsi::fail("solid: point load: nodal force vector has {} values, expected {}", nodal.size(),
+              x.size());
   const int a = p.nodes[0], b = p.nodes[1];
-  const auto f = point_load_on_edge({x[2 * a], x[2 * a + 1]}, {x[2 * b], x[2 * b + 1]}, s, force, moment);
+  const auto f =
+      point_load_on_edge({x[2 * a], x[2 * a + 1]}, {x[2 * b], x[2 * b + 1]}, s, force, moment);
   for (int i = 0; i < 2; ++i) {
     nodal[2 * a + i] += f[0][i];
     nodal[2 * b + i] += f[1][i];

@@ -28,10 +28,10 @@ namespace solid {
 struct BodyGeometry {
   std::string name;
   BodyKind kind = BodyKind::elastic;
-  bool moving = false;                         // rigid bodies: prescribed motion
-  std::vector<double> x_ref;                   // 2 per node
-  std::vector<std::array<int, 3>> triangles;   // counter-clockwise
-  std::vector<std::array<int, 2>> surface;     // body on the left
+  bool moving = false;                        // rigid bodies: prescribed motion
+  std::vector<double> x_ref;                  // 2 per node
+  std::vector<std::array<int, 3>> triangles;  // counter-clockwise
+  std::vector<std::array<int, 2>> surface;    // body on the left
 };
 
 // A material point on a surface edge, at the current time.

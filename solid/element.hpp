@@ -4,7 +4,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <array>
 
 #include "material.hpp"
@@ -72,7 +71,8 @@ inline double element_internal(const Material& m, const ElementGeometry& g, cons
   if (ke) {
     double DB[3][6];
     for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 6; ++c) DB[r][c] = D(r, 0) * B[0][c] + D(r, 1) * B[1][c] + D(r, 2) * B[2][c];
+      for (int c = 0; c < 6; ++c)
+        DB[r][c] = D(r, 0) * B[0][c] + D(r, 1) * B[1][c] + D(r, 2) * B[2][c];
     double G[3][3];  // dN_a/dX . S . dN_b/dX
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b)

@@ -58,8 +58,8 @@ Mesh read_gmsh(const std::filesystem::path& file, const GmshOptions& options,
     std::string first;
     std::getline(in, first);
     if (first.rfind("$MeshFormat", 0) != 0)
-      throw fsi::InputError(fmt::format(
-          "{}: mesh file '{}' is not a Gmsh mesh (no $MeshFormat header)", key, name));
+      throw fsi::InputError(
+          fmt::format("{}: mesh file '{}' is not a Gmsh mesh (no $MeshFormat header)", key, name));
   }
 
   GmshScope scope(options);
@@ -97,7 +97,8 @@ Mesh read_gmsh(const std::filesystem::path& file, const GmshOptions& options,
       if (types[k] != 2)
         throw fsi::InputError(fmt::format(
             "{}: mesh '{}' has surface elements of Gmsh type {}; only 3-node triangles are "
-            "supported (set Mesh.ElementOrder = 1 and no recombination)", key, name, types[k]));
+            "supported (set Mesh.ElementOrder = 1 and no recombination)",
+            key, name, types[k]));
       for (std::size_t e = 0; e < etags[k].size(); ++e) {
         tris.push_back({enodes[k][3 * e], enodes[k][3 * e + 1], enodes[k][3 * e + 2]});
         group.push_back(tag);
@@ -106,8 +107,8 @@ Mesh read_gmsh(const std::filesystem::path& file, const GmshOptions& options,
     }
   }
   if (tris.empty())
-    throw fsi::InputError(fmt::format("{}: mesh '{}' holds no triangles (is it a 2D Gmsh mesh?)",
-                                      key, name));
+    throw fsi::InputError(
+        fmt::format("{}: mesh '{}' holds no triangles (is it a 2D Gmsh mesh?)", key, name));
 
   // Keep the nodes that triangles use, numbered in order of appearance in Gmsh's node list.
   std::vector<int> new_index(tags.size(), -1);
@@ -121,7 +122,8 @@ Mesh read_gmsh(const std::filesystem::path& file, const GmshOptions& options,
       mesh.x.push_back(coord[3 * k + 1]);
     }
   auto node_of = [&](std::size_t tag) { return new_index[tag_index.at(tag)]; };
-  for (const auto& t : tris) mesh.triangles.push_back({node_of(t[0]), node_of(t[1]), node_of(t[2])});
+  for (const auto& t : tris)
+    mesh.triangles.push_back({node_of(t[0]), node_of(t[1]), node_of(t[2])});
 
   // Regions: physical surfaces; surfaces in none form the region "(unnamed)".
   std::map<int, int> surface_region;

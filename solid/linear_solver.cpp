@@ -19,7 +19,9 @@ struct LinearSolver::Impl {
 #endif
 };
 
-LinearSolver::LinearSolver(Backend backend) : m(std::make_unique<Impl>()) { m->requested = backend; }
+LinearSolver::LinearSolver(Backend backend) : m(std::make_unique<Impl>()) {
+  m->requested = backend;
+}
 LinearSolver::~LinearSolver() = default;
 
 bool LinearSolver::has_cholmod() {
@@ -78,6 +80,8 @@ Eigen::MatrixXd LinearSolver::solve(const Eigen::MatrixXd& b) const {
   return m->ldlt.solve(b);
 }
 
-std::string LinearSolver::backend() const { return m->use_cholmod ? "cholmod-supernodal" : "simplicial-ldlt"; }
+std::string LinearSolver::backend() const {
+  return m->use_cholmod ? "cholmod-supernodal" : "simplicial-ldlt";
+}
 
 }  // namespace solid

@@ -9,7 +9,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-
 #include <memory>
 #include <string>
 

@@ -3,7 +3,6 @@
 #include "material.hpp"
 
 #include <Eigen/LU>
-
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -79,8 +78,8 @@ double neo_hookean(const Material& m, const Eigen::Matrix2d& H, Eigen::Vector3d*
   const double I1 = C.trace() + 1;
   const double Jm23 = std::pow(J, -2.0 / 3.0);
   // J^(-2/3) I1 - 3 and J - 1 evaluated without cancellation near the reference state.
-  const double tr_e2 = 2 * green_lagrange(H).trace();  // I1 - 3
-  const double jm1 = H.trace() + H.determinant();      // J - 1
+  const double tr_e2 = 2 * green_lagrange(H).trace();              // I1 - 3
+  const double jm1 = H.trace() + H.determinant();                  // J - 1
   const double jm23m1 = std::expm1(-2.0 / 3.0 * std::log1p(jm1));  // J^(-2/3) - 1
   const double W = 0.5 * m.mu * (jm23m1 * I1 + tr_e2) + 0.5 * m.bulk * jm1 * jm1;
   const double detC = J * J;

@@ -93,7 +93,8 @@ MeshQuality finalize_mesh(Mesh& mesh, const std::vector<int>& orientation_group)
   q.min_edge = std::numeric_limits<double>::max();
   for (int e = 0; e < nt; ++e) {
     const auto& t = mesh.triangles[e];
-    const double l0 = edge2(mesh, t[0], t[1]), l1 = edge2(mesh, t[1], t[2]), l2 = edge2(mesh, t[2], t[0]);
+    const double l0 = edge2(mesh, t[0], t[1]), l1 = edge2(mesh, t[1], t[2]),
+                 l2 = edge2(mesh, t[2], t[0]);
     const double lmax = std::max({l0, l1, l2});
     const double a = std::abs(signed_area(mesh, t));
     if (!(a > 1e-12 * lmax))
@@ -141,9 +142,9 @@ MeshQuality finalize_mesh(Mesh& mesh, const std::vector<int>& orientation_group)
       c.first++;
       c.second = {a, b};
       if (c.first > 2)
-        throw fsi::InputError(fmt::format(
-            "mesh {}: edge {}-{} is shared by more than two elements (element {})", mesh.source,
-            a, b, e));
+        throw fsi::InputError(
+            fmt::format("mesh {}: edge {}-{} is shared by more than two elements (element {})",
+                        mesh.source, a, b, e));
     }
   }
   mesh.surface.clear();
@@ -196,7 +197,8 @@ Mesh rectangle_mesh(double x0, double y0, double lx, double ly, int nx, int ny, 
         m.triangles.push_back({e, a, centre});
         continue;
       }
-      const bool rising = d == Diagonals::right || (d == Diagonals::criss_cross && (i + j) % 2 == 0);
+      const bool rising =
+          d == Diagonals::right || (d == Diagonals::criss_cross && (i + j) % 2 == 0);
       if (rising) {
         m.triangles.push_back({a, b, c});
         m.triangles.push_back({a, c, e});

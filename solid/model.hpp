@@ -49,7 +49,8 @@ struct Load {
 };
 
 // Prescribed rigid motion: x(t) = c + d(t) + R(theta(t)) (X - c), with
-// d(t) = velocity t + amplitude sin(2 pi f t + phase), theta(t) = omega t + angle sin(2 pi f t + phase).
+// d(t) = velocity t + amplitude sin(2 pi f t + phase), theta(t) = omega t + angle sin(2 pi f t +
+// phase).
 struct RigidMotion {
   Vec2 center{0, 0};
   Vec2 velocity{0, 0};
@@ -69,9 +70,9 @@ struct BodySpec {
   std::vector<Material> materials;  // one per mesh.region_names entry (elastic bodies)
   std::vector<Constraint> constraints;
   std::vector<Load> loads;
-  RigidMotion motion;                // rigid bodies
-  Vec2 initial_velocity{0, 0};       // elastic bodies: uniform initial velocity
-  bool gravity = true;               // gravity acts on this body
+  RigidMotion motion;           // rigid bodies
+  Vec2 initial_velocity{0, 0};  // elastic bodies: uniform initial velocity
+  bool gravity = true;          // gravity acts on this body
 };
 
 // Frictionless contact between two bodies: the nodes of `slave` against the surface of `master`
@@ -92,8 +93,8 @@ enum class Analysis { dynamic, statics };
 
 struct Settings {
   Analysis analysis = Analysis::dynamic;
-  int load_steps = 1;              // static analysis
-  double fluid_density = 0;        // rho_f: inertia and gravity use rho_s - rho_f
+  int load_steps = 1;        // static analysis
+  double fluid_density = 0;  // rho_f: inertia and gravity use rho_s - rho_f
   Vec2 gravity{0, 0};
   bool lumped_mass = false;
   double newton_tolerance = 1e-10;  // on ||R|| relative to the force scale

@@ -27,8 +27,10 @@ class ShiftInvertOp {
     const Eigen::SparseMatrix<double> A = m_K - sigma * m_M;
     m_solver.analyze(A);
     if (!m_solver.factorize(A))
-      fsi::fail("solid: modes: K - sigma M is singular for sigma = {} (a body without constraint "
-                "has zero-frequency modes; give a negative shift)", sigma);
+      fsi::fail(
+          "solid: modes: K - sigma M is singular for sigma = {} (a body without constraint "
+          "has zero-frequency modes; give a negative shift)",
+          sigma);
   }
   void perform_op(const double* x_in, double* y_out) const {
     Eigen::Map<const Eigen::VectorXd> x(x_in, m_K.rows());
@@ -56,8 +58,10 @@ Modes Solver::modes(int count, double shift) const {
     const double zero[2] = {0, 0};
     for (int e = 0; e < B.spec.mesh.num_triangles(); ++e) {
       if (!(B.rho_inertia[e] > 0))
-        fsi::fail("solid: modes need a positive inertial density rho_s - rho_f; body '{}' element "
-                  "{} has {}", B.spec.name, e, B.rho_inertia[e]);
+        fsi::fail(
+            "solid: modes need a positive inertial density rho_s - rho_f; body '{}' element "
+            "{} has {}",
+            B.spec.name, e, B.rho_inertia[e]);
       double fe[6], ke[36], J;
       element_internal(B.spec.materials[B.material[e]], B.geo[e], zero, zero, zero, fe, ke, &J);
       double me[3][3];

@@ -20,7 +20,9 @@ double fluid_density_of(const fsi::Runtime& rt) {
   return root.has("fluid") ? root.table("fluid").positive("density") : 0.0;
 }
 
-std::string body_group(const std::string& name) { return "/body_" + name; }
+std::string body_group(const std::string& name) {
+  return "/body_" + name;
+}
 
 }  // namespace
 
@@ -42,13 +44,17 @@ SolidProgram::SolidProgram(fsi::Runtime& rt)
     m_h5.write(g + "/region", region);
     m_h5.set_attribute(g, "kind", s.kind(b) == BodyKind::rigid ? "rigid" : "elastic");
     m_h5.set_attribute(g, "min_quality", m_cfg.quality[b].min_quality);
-    m_xdmf.emplace_back(rt.out_dir() / fmt::format("solid_{}.xdmf", m_cfg.model.bodies[b].name),
-                        rt.out_dir() / "solid.h5",
-                        fsi::XdmfTriangles{g + "/triangles", m.triangles.size(), std::size_t(m.num_nodes())},
-                        m_cfg.model.bodies[b].name);
+    m_xdmf.emplace_back(
+        rt.out_dir() / fmt::format("solid_{}.xdmf", m_cfg.model.bodies[b].name),
+        rt.out_dir() / "solid.h5",
+        fsi::XdmfTriangles{g + "/triangles", m.triangles.size(), std::size_t(m.num_nodes())},
+        m_cfg.model.bodies[b].name);
     if (m_cfg.quality[b].min_quality < 0.1)
-      fmt::print(stderr, "[solid] warning: body '{}' has a poor element {} (quality {:.3g}, 1 = equilateral)\n",
-                 m_cfg.model.bodies[b].name, m_cfg.quality[b].worst_triangle, m_cfg.quality[b].min_quality);
+      fmt::print(
+          stderr,
+          "[solid] warning: body '{}' has a poor element {} (quality {:.3g}, 1 = equilateral)\n",
+          m_cfg.model.bodies[b].name, m_cfg.quality[b].worst_triangle,
+          m_cfg.quality[b].min_quality);
   }
   if (m_cfg.modes > 0) write_modes();
   if (m_cfg.initial_mode > 0) {
@@ -71,8 +77,9 @@ SolidProgram::SolidProgram(fsi::Runtime& rt)
     m_probes.emplace(rt.out_dir() / "solid_probes.csv",
                      fsi::probe_columns(names, {"x", "y", "ux", "uy", "vx", "vy"}));
   }
-  std::vector<std::string> cols{"kinetic", "strain", "load_potential", "total_energy",
-                                "min_gap", "newton_iterations", "active_contacts"};
+  std::vector<std::string> cols{"kinetic",        "strain",  "load_potential",
+                                "total_energy",   "min_gap", "newton_iterations",
+                                "active_contacts"};
   for (const auto& b : m_cfg.model.bodies) {
     cols.push_back(b.name + ".contact_fx");
     cols.push_back(b.name + ".contact_fy");
@@ -92,7 +99,8 @@ void SolidProgram::write_modes() {
     for (int b = 0; b < m_solver->num_bodies(); ++b) {
       const auto& sh = m_modes.shapes[k][b];
       std::vector<double> v3;
-      for (std::size_t n = 0; n < sh.size() / 2; ++n) v3.insert(v3.end(), {sh[2 * n], sh[2 * n + 1], 0.0});
+      for (std::size_t n = 0; n < sh.size() / 2; ++n)
+        v3.insert(v3.end(), {sh[2 * n], sh[2 * n + 1], 0.0});
       m_h5.write(fmt::format("{}/mode_{}", body_group(m_cfg.model.bodies[b].name), k + 1), v3,
                  {sh.size() / 2, 3});
     }
@@ -102,12 +110,14 @@ void SolidProgram::write_modes() {
     const std::string& name = m_cfg.model.bodies[b].name;
     const std::string g = body_group(name);
     const Mesh& m = m_solver->mesh(b);
-    fsi::XdmfWriter x(m_rt.out_dir() / fmt::format("solid_{}_modes.xdmf", name), m_rt.out_dir() / "solid.h5",
-                      fsi::XdmfTriangles{g + "/triangles", m.triangles.size(), std::size_t(m.num_nodes()),
-                                         g + "/x_ref"},
+    fsi::XdmfWriter x(m_rt.out_dir() / fmt::format("solid_{}_modes.xdmf", name),
+                      m_rt.out_dir() / "solid.h5",
+                      fsi::XdmfTriangles{g + "/triangles", m.triangles.size(),
+                                         std::size_t(m.num_nodes()), g + "/x_ref"},
                       name + " modes");
     for (std::size_t k = 0; k < f.size(); ++k)
-      x.add_step(f[k], {{"mode_shape", fsi::XdmfCenter::node, fmt::format("{}/mode_{}", g, k + 1), 3}});
+      x.add_step(f[k],
+                 {{"mode_shape", fsi::XdmfCenter::node, fmt::format("{}/mode_{}", g, k + 1), 3}});
   }
   for (std::size_t k = 0; k < f.size(); ++k)
     fmt::print("[solid] mode {}: omega = {:.8g}, f = {:.8g}\n", k + 1, m_modes.omega[k], f[k]);
@@ -188,8 +198,9 @@ void SolidProgram::write_fields(long step, double t) {
     };
     m_h5.write(g + "/displacement", vec3(s.displacements(b)), {nn, 3});
     m_h5.write(g + "/velocity", vec3(s.velocities(b)), {nn, 3});
-    std::vector<fsi::XdmfAttribute> at{{"displacement", fsi::XdmfCenter::node, g + "/displacement", 3},
-                                       {"velocity", fsi::XdmfCenter::node, g + "/velocity", 3}};
+    std::vector<fsi::XdmfAttribute> at{
+        {"displacement", fsi::XdmfCenter::node, g + "/displacement", 3},
+        {"velocity", fsi::XdmfCenter::node, g + "/velocity", 3}};
     if (s.kind(b) == BodyKind::elastic) {
       m_h5.write(g + "/von_mises", s.element_von_mises(b), {nt});
       m_h5.write(g + "/det_f", s.element_det_f(b), {nt});
@@ -227,8 +238,13 @@ void SolidProgram::output(long step, double t, bool fields) {
     m_probes->write(t, m_row);
   }
   const double kin = s.kinetic_energy(), str = s.strain_energy(), pot = s.load_potential();
-  std::vector<double> h{kin, str, pot, kin + str + pot, std::isfinite(s.min_contact_gap()) ? s.min_contact_gap() : 0.0,
-                        double(m_last.iterations), double(m_last.active_contacts)};
+  std::vector<double> h{kin,
+                        str,
+                        pot,
+                        kin + str + pot,
+                        std::isfinite(s.min_contact_gap()) ? s.min_contact_gap() : 0.0,
+                        double(m_last.iterations),
+                        double(m_last.active_contacts)};
   for (int b = 0; b < s.num_bodies(); ++b) {
     const Vec2 f = s.total_contact_force(b);
     h.push_back(f[0]);
@@ -254,7 +270,8 @@ nlohmann::json SolidProgram::report() const {
   j["newton_iterations"] = m_newton_total;
   j["newton_iterations_max"] = m_newton_max;
   j["phases"] = {{"assembly", m_assembly}, {"factorization", m_factor}, {"solve", m_solve}};
-  j["energy"] = {{"kinetic", s.kinetic_energy()}, {"strain", s.strain_energy()},
+  j["energy"] = {{"kinetic", s.kinetic_energy()},
+                 {"strain", s.strain_energy()},
                  {"load_potential", s.load_potential()}};
   nlohmann::json bodies = nlohmann::json::array();
   for (int b = 0; b < s.num_bodies(); ++b) {

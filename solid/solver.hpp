@@ -8,11 +8,10 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-
 #include <memory>
 #include <set>
-#include <utility>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "contact.hpp"
@@ -24,9 +23,9 @@ namespace solid {
 
 // What one step (or one load step) did.
 struct StepReport {
-  int iterations = 0;                // Newton iterations (linear solves)
-  std::vector<double> residuals;     // ||R|| at each iteration, first one before any solve
-  double tolerance = 0;              // the residual target of this step
+  int iterations = 0;             // Newton iterations (linear solves)
+  std::vector<double> residuals;  // ||R|| at each iteration, first one before any solve
+  double tolerance = 0;           // the residual target of this step
   bool converged = false;
   int active_contacts = 0;
   double assembly_seconds = 0, factor_seconds = 0, solve_seconds = 0;
@@ -34,8 +33,9 @@ struct StepReport {
 
 // Eigenmodes of K phi = omega^2 M phi about the reference state (paper Eq. 28).
 struct Modes {
-  std::vector<double> omega;                  // angular frequencies, ascending [rad / time]
-  std::vector<std::vector<std::vector<double>>> shapes;  // [mode][body] nodal (x0, y0, ...), M-normalised
+  std::vector<double> omega;  // angular frequencies, ascending [rad / time]
+  std::vector<std::vector<std::vector<double>>>
+      shapes;  // [mode][body] nodal (x0, y0, ...), M-normalised
 };
 
 class Solver {
@@ -94,7 +94,8 @@ class Solver {
   std::vector<double> contact_forces(int b) const;
   std::vector<double> contact_pressure(int b) const;
   Vec2 total_contact_force(int b) const;
-  double min_contact_gap() const;  // smallest signed gap over every contact candidate (+inf if none)
+  double min_contact_gap()
+      const;  // smallest signed gap over every contact candidate (+inf if none)
 
   // Support reaction on the prescribed nodes of boundary `name` of body b: the force the
   // support exerts on the body (sum over its constrained nodes).
@@ -137,8 +138,8 @@ class Solver {
   int m_neq = 0;
   double m_time = 0;
   long m_step = 0;
-  double m_force_scale = 0;  // norm of |F_ext| + |Q| + |inertia| from the last assembly
-  double m_roundoff_scale = 0;  // the same with the terms of c0 M u: the round-off floor
+  double m_force_scale = 0;              // norm of |F_ext| + |Q| + |inertia| from the last assembly
+  double m_roundoff_scale = 0;           // the same with the terms of c0 M u: the round-off floor
   Eigen::SparseMatrix<double> m_matrix;  // lower triangle of K_eff on the free equations
   std::set<std::pair<int, int>> m_contact_entries;  // extra (row, col) entries contact needs
   Eigen::VectorXd m_residual;

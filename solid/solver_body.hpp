@@ -23,7 +23,7 @@ struct Solver::Body {
   BodySpec spec;
   int index = 0;
   std::vector<ElementGeometry> geo;
-  std::vector<int> material;       // per element
+  std::vector<int> material;        // per element
   std::vector<double> rho_inertia;  // per element: rho_s - rho_f
   std::vector<double> f_cpl;        // coupling force of the current step: an impulse over it
   std::vector<double> mass_row;     // per dof: row sum of M (zero: massless dof)

@@ -1,7 +1,6 @@
 // Reading [solid] from a scene: a complete scene, and each kind of bad input with its error text
 // (key, value and file named).
 #include <catch2/catch.hpp>
-
 #include <filesystem>
 #include <fstream>
 
@@ -114,18 +113,24 @@ bodies = ["floor", "bar"]
 }
 
 TEST_CASE("bad elastic constants name the key, the value and the file", "[config][input]") {
-  CHECK_THROWS_WITH(read("nu_half.toml", with_material("density = 1\nyoungs_modulus = 1\npoisson_ratio = 0.5\n")),
-                    Catch::Contains("solid.body[0].material[0].poisson_ratio") &&
-                        Catch::Contains("got 0.5") && Catch::Contains("nu_half.toml"));
-  CHECK_THROWS_WITH(read("nu_low.toml", with_material("density = 1\nyoungs_modulus = 1\npoisson_ratio = -1\n")),
-                    Catch::Contains("poisson_ratio") && Catch::Contains("got -1"));
-  CHECK_THROWS_WITH(read("e_neg.toml", with_material("density = 1\nyoungs_modulus = -3\npoisson_ratio = 0.3\n")),
-                    Catch::Contains("solid.body[0].material[0].youngs_modulus") && Catch::Contains("-3") &&
-                        Catch::Contains("e_neg.toml"));
-  CHECK_THROWS_WITH(read("g_zero.toml", with_material("density = 1\nshear_modulus = 0\nbulk_modulus = 3\n")),
-                    Catch::Contains("shear_modulus") && Catch::Contains("got 0"));
-  CHECK_THROWS_WITH(read("rho_zero.toml", with_material("density = 0\nyoungs_modulus = 1\npoisson_ratio = 0.3\n")),
-                    Catch::Contains("solid.body[0].material[0].density") && Catch::Contains("got 0"));
+  CHECK_THROWS_WITH(
+      read("nu_half.toml", with_material("density = 1\nyoungs_modulus = 1\npoisson_ratio = 0.5\n")),
+      Catch::Contains("solid.body[0].material[0].poisson_ratio") && Catch::Contains("got 0.5") &&
+          Catch::Contains("nu_half.toml"));
+  CHECK_THROWS_WITH(
+      read("nu_low.toml", with_material("density = 1\nyoungs_modulus = 1\npoisson_ratio = -1\n")),
+      Catch::Contains("poisson_ratio") && Catch::Contains("got -1"));
+  CHECK_THROWS_WITH(
+      read("e_neg.toml", with_material("density = 1\nyoungs_modulus = -3\npoisson_ratio = 0.3\n")),
+      Catch::Contains("solid.body[0].material[0].youngs_modulus") && Catch::Contains("-3") &&
+          Catch::Contains("e_neg.toml"));
+  CHECK_THROWS_WITH(
+      read("g_zero.toml", with_material("density = 1\nshear_modulus = 0\nbulk_modulus = 3\n")),
+      Catch::Contains("shear_modulus") && Catch::Contains("got 0"));
+  CHECK_THROWS_WITH(
+      read("rho_zero.toml",
+           with_material("density = 0\nyoungs_modulus = 1\npoisson_ratio = 0.3\n")),
+      Catch::Contains("solid.body[0].material[0].density") && Catch::Contains("got 0"));
   CHECK_THROWS_WITH(read("pair.toml", with_material("density = 1\nyoungs_modulus = 1\n")),
                     Catch::Contains("one pair"));
 }
@@ -140,58 +145,77 @@ TEST_CASE("missing or non-Gmsh mesh files", "[config][input]") {
                     Catch::Contains("solid.body[0].mesh") && Catch::Contains("plain.msh") &&
                         Catch::Contains("not a Gmsh mesh"));
   write("shape.stl", "solid x\n");
-  CHECK_THROWS_WITH(read("stl.toml", head + "mesh = \"shape.stl\"\n"), Catch::Contains("not a Gmsh file"));
+  CHECK_THROWS_WITH(read("stl.toml", head + "mesh = \"shape.stl\"\n"),
+                    Catch::Contains("not a Gmsh file"));
 }
 
 TEST_CASE("a physical group the mesh lacks", "[config][input]") {
   const std::string geo = (source_dir / "runs/turek-hron-csm/bar.geo").string();
   const std::string head = "[solid]\n[[solid.body]]\nname = \"bar\"\nmesh = \"" + geo +
                            "\"\nmesh_parameters = \"nx = 10, ny = 2\"\n";
-  const std::string mat = "[[solid.body.material]]\nmodel = \"neo-hookean\"\ndensity = 1\n"
-                          "youngs_modulus = 1\npoisson_ratio = 0.3\n";
-  CHECK_THROWS_WITH(read("noboundary.toml", head + mat + "[[solid.body.constraint]]\ntype = \"fixed\"\nboundary = \"clmap\"\n"),
-                    Catch::Contains("solid.body[0].constraint[0].boundary") && Catch::Contains("\"clmap\"") &&
-                        Catch::Contains("lacks") && Catch::Contains("clamp") && Catch::Contains("noboundary.toml"));
-  CHECK_THROWS_WITH(read("noregion.toml", head + "[[solid.body.material]]\nregion = \"cover\"\nmodel = \"neo-hookean\"\n"
-                                                 "density = 1\nyoungs_modulus = 1\npoisson_ratio = 0.3\n"),
-                    Catch::Contains("solid.body[0].material[0].region") && Catch::Contains("\"cover\"") &&
-                        Catch::Contains("its regions: bar"));
+  const std::string mat =
+      "[[solid.body.material]]\nmodel = \"neo-hookean\"\ndensity = 1\n"
+      "youngs_modulus = 1\npoisson_ratio = 0.3\n";
+  CHECK_THROWS_WITH(
+      read("noboundary.toml",
+           head + mat + "[[solid.body.constraint]]\ntype = \"fixed\"\nboundary = \"clmap\"\n"),
+      Catch::Contains("solid.body[0].constraint[0].boundary") && Catch::Contains("\"clmap\"") &&
+          Catch::Contains("lacks") && Catch::Contains("clamp") &&
+          Catch::Contains("noboundary.toml"));
+  CHECK_THROWS_WITH(
+      read("noregion.toml",
+           head + "[[solid.body.material]]\nregion = \"cover\"\nmodel = \"neo-hookean\"\n"
+                  "density = 1\nyoungs_modulus = 1\npoisson_ratio = 0.3\n"),
+      Catch::Contains("solid.body[0].material[0].region") && Catch::Contains("\"cover\"") &&
+          Catch::Contains("its regions: bar"));
 }
 
 TEST_CASE("an inverted or degenerate element in the mesh file", "[config][input]") {
-  write("flip.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n"
-                    "5 0.5 0.5 0\n$EndNodes\n$Elements\n4\n1 2 2 1 1 1 2 5\n2 2 2 1 1 2 3 5\n"
-                    "3 2 2 1 1 3 4 5\n4 2 2 1 1 5 1 4\n$EndElements\n");
-  CHECK_THROWS_WITH(read("flip.toml", "[solid]\n[[solid.body]]\nname = \"b\"\nmesh = \"flip.msh\"\n"),
-                    Catch::Contains("flip.msh") && Catch::Contains("element 3") && Catch::Contains("inverted"));
-  write("flat.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 2 0 0\n"
-                    "$EndNodes\n$Elements\n2\n1 2 2 1 1 1 2 3\n2 2 2 1 1 1 2 4\n$EndElements\n");
-  CHECK_THROWS_WITH(read("flat.toml", "[solid]\n[[solid.body]]\nname = \"b\"\nmesh = \"flat.msh\"\n"),
-                    Catch::Contains("flat.msh") && Catch::Contains("element 1") && Catch::Contains("degenerate"));
+  write("flip.msh",
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n"
+        "5 0.5 0.5 0\n$EndNodes\n$Elements\n4\n1 2 2 1 1 1 2 5\n2 2 2 1 1 2 3 5\n"
+        "3 2 2 1 1 3 4 5\n4 2 2 1 1 5 1 4\n$EndElements\n");
+  CHECK_THROWS_WITH(
+      read("flip.toml", "[solid]\n[[solid.body]]\nname = \"b\"\nmesh = \"flip.msh\"\n"),
+      Catch::Contains("flip.msh") && Catch::Contains("element 3") && Catch::Contains("inverted"));
+  write("flat.msh",
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 2 0 0\n"
+        "$EndNodes\n$Elements\n2\n1 2 2 1 1 1 2 3\n2 2 2 1 1 1 2 4\n$EndElements\n");
+  CHECK_THROWS_WITH(
+      read("flat.toml", "[solid]\n[[solid.body]]\nname = \"b\"\nmesh = \"flat.msh\"\n"),
+      Catch::Contains("flat.msh") && Catch::Contains("element 1") && Catch::Contains("degenerate"));
 }
 
 TEST_CASE("a body without constraint in a static solve", "[config][input]") {
   CHECK_THROWS_WITH(read("free.toml", "[solid]\nanalysis = \"static\"\n" + block),
-                    Catch::Contains("[solid.body[0]]") && Catch::Contains("\"block\" has no fixed or displacement constraint") &&
+                    Catch::Contains("[solid.body[0]]") &&
+                        Catch::Contains("\"block\" has no fixed or displacement constraint") &&
                         Catch::Contains("singular") && Catch::Contains("free.toml"));
   // Held in x only: the solver's own check names the missing direction.
-  const Config c = read("half.toml", "[solid]\nanalysis = \"static\"\n" + block +
-                                         "[[solid.body.constraint]]\ntype = \"fixed\"\nboundary = \"left\"\ncomponents = \"x\"\n");
-  CHECK_THROWS_WITH(Solver(c.model), Catch::Contains("body 'block' has no constraint that holds it in y"));
+  const Config c = read(
+      "half.toml",
+      "[solid]\nanalysis = \"static\"\n" + block +
+          "[[solid.body.constraint]]\ntype = \"fixed\"\nboundary = \"left\"\ncomponents = \"x\"\n");
+  CHECK_THROWS_WITH(Solver(c.model),
+                    Catch::Contains("body 'block' has no constraint that holds it in y"));
 }
 
 TEST_CASE("unknown keys and wrong choices", "[config][input]") {
-  CHECK_THROWS_WITH(read("typo.toml", "[solid]\ngravty = [0, -1]\n" + block),
-                    Catch::Contains("gravty") && Catch::Contains("did you mean") && Catch::Contains("gravity"));
+  CHECK_THROWS_WITH(
+      read("typo.toml", "[solid]\ngravty = [0, -1]\n" + block),
+      Catch::Contains("gravty") && Catch::Contains("did you mean") && Catch::Contains("gravity"));
   std::string hooke = with_material("density = 1\nyoungs_modulus = 1\npoisson_ratio = 0.3\n");
   hooke.replace(hooke.find("saint-venant-kirchhoff"), 22, "saint-venant-kirchoff");
   CHECK_THROWS_WITH(read("model.toml", hooke),
                     Catch::Contains("solid.body[0].material[0].model") &&
                         Catch::Contains("did you mean 'saint-venant-kirchhoff'"));
-  CHECK_THROWS_WITH(read("contact.toml", "[solid]\n" + block + "[[solid.contact]]\nbodies = [\"block\", \"lid\"]\n"),
+  CHECK_THROWS_WITH(read("contact.toml", "[solid]\n" + block +
+                                             "[[solid.contact]]\nbodies = [\"block\", \"lid\"]\n"),
                     Catch::Contains("solid.contact[0].bodies") && Catch::Contains("\"lid\""));
-  CHECK_THROWS_WITH(read("probe.toml", "[solid]\n" + block + "[[solid.body.probe]]\nname = \"P\"\npoint = [3, 3]\n"),
-                    Catch::Contains("solid.body[0].probe[0].point") && Catch::Contains("outside body"));
+  CHECK_THROWS_WITH(
+      read("probe.toml",
+           "[solid]\n" + block + "[[solid.body.probe]]\nname = \"P\"\npoint = [3, 3]\n"),
+      Catch::Contains("solid.body[0].probe[0].point") && Catch::Contains("outside body"));
   const Config light = read("buoyant.toml", "[solid]\n" + block, 20.0);
   CHECK_THROWS_WITH(Solver(light.model), Catch::Contains("below the fluid density"));
 }

@@ -2,7 +2,6 @@
 // reaction, either body as slave), a block on a rigid body, a block dropped on a rigid plane
 // (no penetration, no energy growth, it bounces).
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "solver.hpp"
@@ -50,7 +49,8 @@ Model two_blocks(double press, int slave, bool two_way, MaterialModel mm) {
 
 }  // namespace
 
-TEST_CASE("two blocks pressed together: no penetration, contact force = applied load", "[contact]") {
+TEST_CASE("two blocks pressed together: no penetration, contact force = applied load",
+          "[contact]") {
   for (MaterialModel mm : {MaterialModel::saint_venant_kirchhoff, MaterialModel::neo_hookean})
     for (int slave : {0, 1})
       for (bool two_way : {false, true}) {
@@ -62,7 +62,7 @@ TEST_CASE("two blocks pressed together: no penetration, contact force = applied 
           CHECK(r.converged);
           CHECK(r.iterations <= 7);
         }
-        const Vec2 load = s.reaction(1, "top");      // what pushes the punch down
+        const Vec2 load = s.reaction(1, "top");  // what pushes the punch down
         const Vec2 fc_punch = s.total_contact_force(1);
         const Vec2 fc_base = s.total_contact_force(0);
         const Vec2 support = s.reaction(0, "bottom");
@@ -133,11 +133,13 @@ TEST_CASE("a block dropped on a rigid plane bounces without penetration or energ
     const auto& v = s.velocities(0);
     for (std::size_t d = 1; d < v.size(); d += 2) vy += v[d] / (v.size() / 2);
     if (rep.active_contacts > 0) touched = true;
-    if (!touched) min_vy = std::min(min_vy, vy);
-    else max_vy_after = std::max(max_vy_after, vy);
+    if (!touched)
+      min_vy = std::min(min_vy, vy);
+    else
+      max_vy_after = std::max(max_vy_after, vy);
   }
-  INFO("impact speed " << -min_vy << ", largest upward speed after " << max_vy_after
-                       << ", energy " << e0 << " -> max " << max_energy << ", gap " << worst_gap);
+  INFO("impact speed " << -min_vy << ", largest upward speed after " << max_vy_after << ", energy "
+                       << e0 << " -> max " << max_energy << ", gap " << worst_gap);
   CHECK(touched);
   CHECK(worst_gap >= -1e-8 * 0.4);
   // Energy scale: the weight times the drop height (the reference state has zero energy).
@@ -169,6 +171,7 @@ TEST_CASE("the segment gap Hessian is the derivative of the gap gradient", "[con
     x[c] -= 2 * h;
     gradient(x, gm);
     x[c] += h;
-    for (int r = 0; r < 6; ++r) CHECK((gp[r] - gm[r]) / (2 * h) == Approx(H[6 * r + c]).margin(1e-7));
+    for (int r = 0; r < 6; ++r)
+      CHECK((gp[r] - gm[r]) / (2 * h) == Approx(H[6 * r + c]).margin(1e-7));
   }
 }

@@ -1,12 +1,11 @@
 // The solver core without scenes: patch tests (uniform stretch and shear exact for both
 // materials), quadratic Newton convergence, energy conservation of the trapezoidal rule,
 // zero excess mass, gravity and reactions, periodic pairs.
-#include <catch2/catch.hpp>
+#include <fmt/format.h>
 
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
-
-#include <fmt/format.h>
 
 #include "solver.hpp"
 
@@ -14,8 +13,12 @@ using namespace solid;
 
 namespace {
 
-Material svk() { return Material::from_young(MaterialModel::saint_venant_kirchhoff, 1.0e3, 0.3, 2.0); }
-Material neo() { return Material::from_young(MaterialModel::neo_hookean, 1.0e3, 0.3, 2.0); }
+Material svk() {
+  return Material::from_young(MaterialModel::saint_venant_kirchhoff, 1.0e3, 0.3, 2.0);
+}
+Material neo() {
+  return Material::from_young(MaterialModel::neo_hookean, 1.0e3, 0.3, 2.0);
+}
 
 // A 4 x 3 rectangle, 6 x 5 cells, interior nodes moved at random (an irregular patch).
 Mesh irregular_patch(Diagonals d) {
@@ -108,8 +111,8 @@ TEST_CASE("patch test: uniform stretch under prescribed displacements", "[patch]
     b.materials = {mat};
     Constraint right = fix("right", true, false), top = fix("top", false, true);
     right.type = top.type = Constraint::Type::displacement;
-    right.displacement = {0.4 * 4, 0};   // stretch 1.4 in x
-    top.displacement = {0, -0.25 * 3};   // 0.75 in y
+    right.displacement = {0.4 * 4, 0};  // stretch 1.4 in x
+    top.displacement = {0, -0.25 * 3};  // 0.75 in y
     b.constraints = {fix("left", true, false), fix("bottom", false, true), right, top};
     model.bodies.push_back(b);
     Solver s(model);
@@ -155,7 +158,8 @@ TEST_CASE("Newton converges quadratically on a large-deflection cantilever", "[n
     // Orders p_k = log(r_k+1 / r_k) / log(r_k / r_k-1) over the iterations above round-off.
     double best = 0;
     for (std::size_t k = 1; k + 1 < r.size(); ++k)
-      if (r[k + 1] > 1e-12 * r[0]) best = std::max(best, std::log(r[k + 1] / r[k]) / std::log(r[k] / r[k - 1]));
+      if (r[k + 1] > 1e-12 * r[0])
+        best = std::max(best, std::log(r[k + 1] / r[k]) / std::log(r[k] / r[k - 1]));
     CHECK(best >= 1.8);
     CHECK(rep[0].iterations <= 12);
   }
@@ -288,6 +292,7 @@ TEST_CASE("a static body without supports is rejected", "[input]") {
   b.materials = {svk()};
   b.constraints = {fix("left", true, false)};
   model.bodies.push_back(b);
-  CHECK_THROWS_WITH(Solver(model), Catch::Contains("body 'loose' has no constraint that holds it in y") &&
-                                       Catch::Contains("static solve is singular"));
+  CHECK_THROWS_WITH(Solver(model),
+                    Catch::Contains("body 'loose' has no constraint that holds it in y") &&
+                        Catch::Contains("static solve is singular"));
 }

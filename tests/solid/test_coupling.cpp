@@ -1,7 +1,6 @@
 // The coupling hook: geometry, surface points and normals, point force + moment as nodal forces
 // (resultant and moment exact), advance with external nodal forces.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 
@@ -83,7 +82,8 @@ TEST_CASE("advance with coupling forces; a body with rho_s = rho_f follows them 
   const Mesh& m = s.mesh(0);
   for (int e = 0; e < static_cast<int>(m.surface.size()); ++e) {
     const auto& ed = m.surface[e];
-    if (m.x[2 * ed[0]] == 1 && m.x[2 * ed[1]] == 1 && std::min(m.x[2 * ed[0] + 1], m.x[2 * ed[1] + 1]) == 0)
+    if (m.x[2 * ed[0]] == 1 && m.x[2 * ed[1]] == 1 &&
+        std::min(m.x[2 * ed[0] + 1], m.x[2 * ed[1] + 1]) == 0)
       tip_edge = e;
   }
   REQUIRE(tip_edge >= 0);
@@ -112,7 +112,8 @@ TEST_CASE("advance with coupling forces; a body with rho_s = rho_f follows them 
   CHECK(h2.positions(0)[2 * 62 + 1] - 0.1 > 1e-5);
 }
 
-TEST_CASE("a rigid body follows its prescribed motion and carries no equations", "[coupling][rigid]") {
+TEST_CASE("a rigid body follows its prescribed motion and carries no equations",
+          "[coupling][rigid]") {
   Model model = bar(0);
   RigidMotion& m = model.bodies[1].motion;
   m.center = {-0.1, 0.05};

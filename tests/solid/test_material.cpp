@@ -1,8 +1,7 @@
 // Materials and the element kernel: stress = dW/dE, tangent = dS/dE and element stiffness =
 // dQ/dx against central finite differences; small-strain limits.
-#include <catch2/catch.hpp>
-
 #include <Eigen/Eigenvalues>
+#include <catch2/catch.hpp>
 
 #include "element.hpp"
 #include "material.hpp"
@@ -15,7 +14,8 @@ namespace {
 Eigen::Matrix2d stretch_from_e(const Eigen::Matrix2d& E) {
   const Eigen::Matrix2d C = Eigen::Matrix2d::Identity() + 2 * E;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(C);
-  return es.eigenvectors() * es.eigenvalues().cwiseSqrt().asDiagonal() * es.eigenvectors().transpose() -
+  return es.eigenvectors() * es.eigenvalues().cwiseSqrt().asDiagonal() *
+             es.eigenvectors().transpose() -
          Eigen::Matrix2d::Identity();
 }
 
@@ -26,7 +26,8 @@ std::vector<Material> both_materials() {
 
 }  // namespace
 
-TEST_CASE("stress is the derivative of the energy and the tangent that of the stress", "[material]") {
+TEST_CASE("stress is the derivative of the energy and the tangent that of the stress",
+          "[material]") {
   Eigen::Matrix2d E;
   E << 0.08, -0.05, -0.05, -0.11;
   const double h = 1e-6;

@@ -1,7 +1,6 @@
 // Meshes: built-in rectangles, Gmsh .geo/.msh import with physical groups, quality checks and
 // the errors for missing, non-Gmsh, inverted and degenerate meshes.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -27,7 +26,8 @@ const char* msh_header = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
 }  // namespace
 
 TEST_CASE("built-in rectangles: counts, area, boundaries, orientation", "[mesh]") {
-  for (Diagonals d : {Diagonals::criss_cross, Diagonals::right, Diagonals::left, Diagonals::union_jack}) {
+  for (Diagonals d :
+       {Diagonals::criss_cross, Diagonals::right, Diagonals::left, Diagonals::union_jack}) {
     const Mesh m = rectangle_mesh(1, 2, 3, 0.5, 6, 2, d);
     const bool jack = d == Diagonals::union_jack;
     CHECK(m.num_nodes() == 7 * 3 + (jack ? 12 : 0));
@@ -84,10 +84,12 @@ TEST_CASE("a .geo file is meshed through Gmsh with its physical groups", "[mesh]
 
 TEST_CASE("a .msh file with regions, boundaries and a clockwise surface", "[mesh][gmsh]") {
   // Two triangles listed clockwise: the surface is flipped as a whole, not rejected.
-  const auto p = write_file("cw.msh", std::string(msh_header) +
-                                          "$PhysicalNames\n2\n1 7 \"base\"\n2 1 \"soft\"\n$EndPhysicalNames\n"
-                                          "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n$EndNodes\n"
-                                          "$Elements\n3\n1 1 2 7 1 1 2\n2 2 2 1 1 1 3 2\n3 2 2 1 1 1 4 3\n$EndElements\n");
+  const auto p = write_file(
+      "cw.msh",
+      std::string(msh_header) +
+          "$PhysicalNames\n2\n1 7 \"base\"\n2 1 \"soft\"\n$EndPhysicalNames\n"
+          "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n$EndNodes\n"
+          "$Elements\n3\n1 1 2 7 1 1 2\n2 2 2 1 1 1 3 2\n3 2 2 1 1 1 4 3\n$EndElements\n");
   const Mesh m = read_gmsh(p);
   CHECK(m.num_triangles() == 2);
   CHECK(m.area() == Approx(1.0));
@@ -116,14 +118,16 @@ TEST_CASE("bad meshes are rejected with the file and the element named", "[mesh]
                           "4 2 2 1 1 5 1 4\n$EndElements\n");
   CHECK_THROWS_AS(read_gmsh(inverted), fsi::InputError);
   CHECK_THROWS_WITH(read_gmsh(inverted), Catch::Contains("inverted.msh") &&
-                                             Catch::Contains("element 3") && Catch::Contains("is inverted"));
+                                             Catch::Contains("element 3") &&
+                                             Catch::Contains("is inverted"));
 
   const auto degenerate = write_file(
       "degenerate.msh", std::string(msh_header) +
                             "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 2 0 0\n$EndNodes\n"
                             "$Elements\n2\n1 2 2 1 1 1 2 3\n2 2 2 1 1 1 2 4\n$EndElements\n");
-  CHECK_THROWS_WITH(read_gmsh(degenerate),
-                    Catch::Contains("degenerate.msh") && Catch::Contains("element 1") && Catch::Contains("degenerate"));
+  CHECK_THROWS_WITH(read_gmsh(degenerate), Catch::Contains("degenerate.msh") &&
+                                               Catch::Contains("element 1") &&
+                                               Catch::Contains("degenerate"));
 }
 
 TEST_CASE("locating a reference point gives its element and barycentric weights", "[mesh]") {

@@ -1,7 +1,6 @@
 // Eigenmodes (paper Eq. 28) of a slender clamped-free beam against Euler-Bernoulli with the
 // plane-strain modulus, and the same frequency from a free-vibration time run.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "solver.hpp"
@@ -35,7 +34,8 @@ double euler_bernoulli(int k) {
 
 }  // namespace
 
-TEST_CASE("cantilever eigenfrequencies within 2 % of Euler-Bernoulli (8 elements across)", "[modes]") {
+TEST_CASE("cantilever eigenfrequencies within 2 % of Euler-Bernoulli (8 elements across)",
+          "[modes]") {
   Solver s(cantilever(8));
   const Modes m = s.modes(3);
   REQUIRE(m.omega.size() == 3);
@@ -50,7 +50,8 @@ TEST_CASE("cantilever eigenfrequencies within 2 % of Euler-Bernoulli (8 elements
   CHECK(s.kinetic_energy() == Approx(0.5).epsilon(1e-8));
 }
 
-TEST_CASE("a free vibration from the first mode shape has the modal frequency", "[modes][dynamic]") {
+TEST_CASE("a free vibration from the first mode shape has the modal frequency",
+          "[modes][dynamic]") {
   Solver s(cantilever(4));
   const Modes m = s.modes(1);
   const double omega = m.omega[0];
@@ -85,5 +86,6 @@ TEST_CASE("modes need inertia", "[modes][input]") {
   Model model = cantilever(2);
   model.settings.fluid_density = 1;  // rho_s - rho_f = 0
   Solver s(model);
-  CHECK_THROWS_WITH(s.modes(2), Catch::Contains("positive inertial density") && Catch::Contains("'beam'"));
+  CHECK_THROWS_WITH(s.modes(2),
+                    Catch::Contains("positive inertial density") && Catch::Contains("'beam'"));
 }
