@@ -37,12 +37,18 @@ struct Announce {
 // the default coupled scene slower (1.6-1.7 s against 0.9-1.1 s for its 1000 steps), since the
 // waiting programs then take the cores from the one that computes.
 constexpr int kMaxSleepUs = 200;
+
+// The k-th pause of a wait: 20 yields, then sleeps of 5, 10, ... up to kMaxSleepUs µs.
+void back_off(int k) {
+  if (k < 20) std::this_thread::yield();
+  else std::this_thread::sleep_for(std::chrono::microseconds(std::min(kMaxSleepUs, 5 * (k - 19))));
+}
+
 void wait_politely(MPI_Request& req) {
   int done = 0;
   MPI_Test(&req, &done, MPI_STATUS_IGNORE);
   for (int k = 0; !done; ++k) {
-    if (k < 20) std::this_thread::yield();
-    else std::this_thread::sleep_for(std::chrono::microseconds(std::min(kMaxSleepUs, 5 * (k - 19))));
+    back_off(k);
     MPI_Test(&req, &done, MPI_STATUS_IGNORE);
   }
 }
@@ -172,8 +178,7 @@ std::vector<std::byte> Link::recv_bytes(proto::Tag expected) {
   MPI_Status status;
   MPI_Improbe(0, MPI_ANY_TAG, m_comm, &flag, &msg, &status);
   for (int k = 0; !flag; ++k) {
-    if (k < 20) std::this_thread::yield();
-    else std::this_thread::sleep_for(std::chrono::microseconds(std::min(kMaxSleepUs, 5 * (k - 19))));
+    back_off(k);
     MPI_Improbe(0, MPI_ANY_TAG, m_comm, &flag, &msg, &status);
   }
   if (status.MPI_TAG != static_cast<int>(expected))
