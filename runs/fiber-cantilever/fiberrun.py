@@ -9,10 +9,11 @@ import time
 
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+from caserun import BIN, OUT, ROOT, SHORT, finish, metric, relative, run_program  # noqa: E402,F401
+
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-BIN = os.environ.get("FSI_BIN", os.path.join(HERE, "..", "..", "build", "bin"))
-OUT = os.environ.get("FSI_OUT", os.path.join(os.getcwd(), "out"))
-SHORT = "--short" in sys.argv
 
 HEADER = """[scene]
 name = "{name}"
@@ -22,28 +23,6 @@ t_end = {t_end!r}
 [output]
 interval = {interval!r}
 """
-
-
-def run(name, scene_text, expect_error=False):
-    """Write OUT/name.toml, run the fiber program into OUT/name; return (folder, wall seconds).
-    With expect_error, return the program's output instead and require a failure."""
-    os.makedirs(OUT, exist_ok=True)
-    scene = os.path.join(OUT, name + ".toml")
-    with open(scene, "w") as f:
-        f.write(scene_text)
-    folder = os.path.join(OUT, name)
-    t0 = time.time()
-    r = subprocess.run([os.path.join(BIN, "fiber"), scene, "--out-dir", folder, "--overwrite"],
-                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    wall = time.time() - t0
-    if expect_error:
-        if r.returncode == 0:
-            raise RuntimeError(f"fiber should have failed on {scene}")
-        return r.stdout
-    if r.returncode != 0:
-        sys.stderr.write(r.stdout)
-        raise RuntimeError(f"fiber failed on {scene}")
-    return folder, wall
 
 
 def write_points(name, points):
@@ -102,28 +81,6 @@ def period(t, y):
     return 2 * (z[last] - z[0]) / last
 
 
-def metric(value, reference, error, tolerance):
-    ok = bool(np.isfinite(value) and np.isfinite(error) and error <= tolerance)
-    return {"value": float(value), "reference": float(reference), "error": float(error),
-            "tolerance": float(tolerance), "pass": ok}
-
-
-def relative(value, reference, tolerance):
-    return metric(value, reference, abs(value - reference) / abs(reference), tolerance)
-
-
-def finish(case, metrics, extra=None):
-    """Write OUT/summary.json; exit 1 when a metric fails."""
-    s = {"case": case, "short": SHORT, "metrics": metrics}
-    if extra:
-        s.update(extra)
-    with open(os.path.join(OUT, "summary.json"), "w") as f:
-        json.dump(s, f, indent=2)
-    bad = [k for k, m in metrics.items() if not m["pass"]]
-    for k, m in metrics.items():
-        print(f"  {k}: {m['value']:.6g} (reference {m['reference']:.6g}, error {m['error']:.3g}, "
-              f"tolerance {m['tolerance']:.3g}) {'pass' if m['pass'] else 'FAIL'}")
-    if bad:
-        print(f"{case}: failed: {', '.join(bad)}")
-        sys.exit(1)
-    print(f"{case}: all {len(metrics)} metrics pass")
+def run(name, scene_text, expect_error=False):
+    """Run the fiber program on a scene (see caserun.run_program)."""
+    return run_program("fiber", name, scene_text, expect_error)

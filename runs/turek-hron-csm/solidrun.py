@@ -11,11 +11,11 @@ import time
 import h5py
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+from caserun import BIN, OUT, ROOT, SHORT, finish, metric, relative, run_program  # noqa: E402,F401
+
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.environ.get("FSI_ROOT", os.path.abspath(os.path.join(HERE, "..", "..")))
-BIN = os.environ.get("FSI_BIN", os.path.join(ROOT, "build", "bin"))
-OUT = os.environ.get("FSI_OUT", os.path.join(os.getcwd(), "out"))
-SHORT = "--short" in sys.argv
 
 
 def scene_from(path, replace):
@@ -33,23 +33,6 @@ def scene_from(path, replace):
             line = f'mesh = "{os.path.join(folder, name)}"'
         lines.append(line)
     return "\n".join(lines) + "\n"
-
-
-def run(name, scene_text):
-    """Write OUT/name.toml, run the solid program into OUT/name; return (folder, wall seconds)."""
-    os.makedirs(OUT, exist_ok=True)
-    scene = os.path.join(OUT, name + ".toml")
-    with open(scene, "w") as f:
-        f.write(scene_text)
-    folder = os.path.join(OUT, name)
-    t0 = time.time()
-    r = subprocess.run([os.path.join(BIN, "solid"), scene, "--out-dir", folder, "--overwrite"],
-                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    wall = time.time() - t0
-    if r.returncode != 0:
-        sys.stderr.write(r.stdout)
-        raise RuntimeError(f"solid failed on scene {name}")
-    return folder, wall
 
 
 def summary(folder):
@@ -75,27 +58,6 @@ def last_state(folder, body):
     return d
 
 
-def metric(value, reference, error, tolerance):
-    ok = bool(np.isfinite(value) and np.isfinite(error) and error <= tolerance)
-    return {"value": float(value), "reference": float(reference), "error": float(error),
-            "tolerance": float(tolerance), "pass": ok}
-
-
-def relative(value, reference, tolerance):
-    return metric(value, reference, abs(value - reference) / abs(reference), tolerance)
-
-
-def finish(case, metrics, extra=None):
-    """Write OUT/summary.json; exit 1 when a metric fails."""
-    s = {"case": case, "short": SHORT, "metrics": metrics}
-    if extra:
-        s.update(extra)
-    with open(os.path.join(OUT, "summary.json"), "w") as f:
-        json.dump(s, f, indent=2)
-    bad = [k for k, m in metrics.items() if not m["pass"]]
-    for k, m in metrics.items():
-        print(f"  {k}: {m['value']:.6g} (reference {m['reference']:.6g}, error {m['error']:.3g}, "
-              f"tolerance {m['tolerance']:.3g}) {'pass' if m['pass'] else 'FAIL'}")
-    if bad:
-        print(f"{case}: failed: {', '.join(bad)}")
-        sys.exit(1)
+def run(name, scene_text):
+    """Run the solid program on a scene (see caserun.run_program)."""
+    return run_program("solid", name, scene_text)
