@@ -3,9 +3,7 @@ support loads, HDF5 output and report, record metrics as {value, reference, erro
 pass} in summary.json. Environment (set by `./fsi validate`): FSI_ROOT, FSI_BIN, FSI_OUT."""
 import json
 import os
-import subprocess
 import sys
-import time
 
 import numpy as np
 

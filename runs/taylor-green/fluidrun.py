@@ -1,11 +1,8 @@
 """Helpers of the fluid validation cases: run the `fluid` program on a scene, read its HDF5
 output, record metrics as {value, reference, error, tolerance, pass} in summary.json.
 Environment (set by `./fsi validate`): FSI_ROOT, FSI_BIN, FSI_OUT."""
-import json
 import os
-import subprocess
 import sys
-import time
 
 import h5py
 import numpy as np

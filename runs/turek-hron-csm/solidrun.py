@@ -4,9 +4,7 @@ tolerance, pass} in summary.json. Environment (set by `./fsi validate`): FSI_ROO
 FSI_OUT. `--short` selects the quick version that the test suite runs."""
 import json
 import os
-import subprocess
 import sys
-import time
 
 import h5py
 import numpy as np
