@@ -57,8 +57,12 @@ build() {
     cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release >/dev/null
   fi
   say "building"
-  cmake --build "$BUILD" -j "$(nproc)" 2>&1 | grep -E "error|warning|Error" >&2 || true
-  [ "${PIPESTATUS[0]}" -eq 0 ] || die "build failed (cmake --build $BUILD for the full log)"
+  local log=$BUILD/build.log
+  if ! cmake --build "$BUILD" -j "$(nproc)" >"$log" 2>&1; then
+    grep -E "error|Error" "$log" | head -40 >&2
+    die "build failed; the full log is $log"
+  fi
+  grep -E "warning" "$log" >&2 || true
 }
 
 mpirun_flags() {
