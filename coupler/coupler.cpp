@@ -258,6 +258,10 @@ void Coupler::step(long n) {
     m_immersed->reaction(m_fluid_out.fs_u, m_fluid_out.fs_v, m_solid_in.force);
     m_phases.stop("reaction");
   }
+  write_force_probes(n);
+  // Rigid bodies move by their law: their reaction is only measured, not sent.
+  for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
+    if (m_meshes.bodies[b].kind != 0) m_solid_in.force[b].clear();
   add_root_loads();
   // 7: the solid step.
   if (has(Role::solid)) {
@@ -277,7 +281,6 @@ void Coupler::step(long n) {
     l.recv(m_fiber);
     m_phases.stop("fiber");
   }
-  write_force_probes(n);
   m_progress->update(n + 1, fsi::step_time(s, n + 1), s.dt, [&] {
     return fmt::format("CFL {:.3g}  div {:.1e}", m_fluid_out.cfl, m_fluid_out.max_div);
   });
@@ -384,8 +387,10 @@ void Coupler::feedback_forces() {
 }
 
 // The hydrodynamic force on each group: F = Σ_a F_a + d/dt (ρ_f ∫ v dA). The first term is the
-// reaction of f_s; the second restores the inertia of the fluid the forcing carries inside the
-// body (DESIGN.md §4.2: ∫ f_s = ρ_f V a_s − traction).
+// reaction of f_s of this step (before any fiber root load is added); the second restores the
+// inertia of the fluid the forcing carries inside the body (DESIGN.md §4.2: ∫ f_s = ρ_f V a_s −
+// traction), from the bodies' momentum change over the previous step (the state at t^n is the
+// newest the coupler holds when the reaction is known).
 void Coupler::write_force_probes(long n) {
   if (!m_probes) return;
   const auto& bodies = m_meshes.bodies;
