@@ -76,7 +76,7 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
   check_health(s.step + 1, s.time + s.dt, s.dt);
   out.cfl = m_cfl;
   out.max_div = m_div;
-  out.kinetic_energy = 0;
+  out.kinetic_energy = m_energy;
 }
 
 void FluidProgram::check_health(long step, double t, double dt) {
@@ -92,6 +92,7 @@ void FluidProgram::check_health(long step, double t, double dt) {
   } else if (step % m_cfg.health_every == 0) {
     const Extremum d = max_divergence(*m_solver);
     m_div = d.value;
+    m_energy = kinetic_energy(*m_solver);
     if (m_div_first < 0) m_div_first = d.value;
     // Round-off grows slowly with the field; a jump by orders of magnitude is a failure.
     if (d.value * dt > m_cfg.divergence_max) {

@@ -37,6 +37,7 @@ class FluidProgram : public fsi::FluidPort {
   std::vector<double> m_row, m_w1, m_w2;
   CouplingOut m_out;
   double m_cfl = 0, m_div = 0, m_div_first = -1;
+  double m_energy = 0;  // kinetic energy, refreshed with the divergence every health.every steps
   long m_written_step = -1;
 };
 
