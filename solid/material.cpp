@@ -87,10 +87,17 @@ double neo_hookean(const Material& m, const Eigen::Matrix2d& H, Eigen::Vector3d*
   Ci << C(1, 1) / detC, -C(0, 1) / detC, -C(1, 0) / detC, C(0, 0) / detC;
   const double G = m.mu, K = m.bulk;
   if (S) {
+    // S = G J^(-2/3) [(I - C^-1) - (I1 - 3)/3 C^-1] + K J (J - 1) C^-1, with
+    // I - C^-1 = (det C I - adj C) / det C written in E = (C - I)/2 so that no term is a
+    // difference of numbers near 1: a stress of a small strain keeps its relative precision
+    // (otherwise its absolute error is eps (G + K) and Newton cannot reduce a small residual).
+    const Eigen::Matrix2d E = green_lagrange(H);
+    Eigen::Matrix2d IminusCi;
+    IminusCi << (2 * C(1, 1) * E(0, 0) - C(0, 1) * C(1, 0)) / detC, C(0, 1) / detC,
+        C(1, 0) / detC, (2 * C(0, 0) * E(1, 1) - C(0, 1) * C(1, 0)) / detC;
     for (int a = 0; a < 3; ++a) {
       const int i = voigt_i[a], j = voigt_j[a];
-      const double delta = i == j ? 1.0 : 0.0;
-      (*S)(a) = G * Jm23 * (delta - I1 / 3 * Ci(i, j)) + K * (J * J - J) * Ci(i, j);
+      (*S)(a) = G * Jm23 * (IminusCi(i, j) - tr_e2 / 3 * Ci(i, j)) + K * J * jm1 * Ci(i, j);
     }
   }
   if (D) {

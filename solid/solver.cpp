@@ -866,13 +866,14 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
     }
   }
   if (!rep.converged) {
-    // Name the node with the largest residual.
+    // Name the node with the largest residual: that of the assembled equation (a periodic
+    // pair's nodes share one, and their own shares cancel in it), at its first node.
+    int worst_eq = -1;
+    if (m_neq > 0) m_residual.cwiseAbs().maxCoeff(&worst_eq);
     int wb = -1, wn = -1;
-    double wr = -1;
     for (const auto& bp : m_bodies)
-      for (std::size_t d = 0; d < bp->r.size(); ++d)
-        if (bp->is_elastic() && bp->eq[d] >= 0 && std::abs(bp->r[d]) > wr) {
-          wr = std::abs(bp->r[d]);
+      for (std::size_t d = 0; d < bp->eq.size() && wb < 0; ++d)
+        if (bp->is_elastic() && bp->eq[d] == worst_eq) {
           wb = bp->index;
           wn = static_cast<int>(d / 2);
         }

@@ -283,6 +283,42 @@ TEST_CASE("periodic pairs: a strip sheared with periodic ends stays uniform", "[
   CHECK(err <= 1e-12);
 }
 
+TEST_CASE("a periodic massless layer starting from rest converges under a force of 1e-14",
+          "[periodic][newton]") {
+  // The first step of a coupled run from rest: the fluid's force on the layer is ~1e-14, so the
+  // Newton tolerance (relative to it) is ~1e-24. The residual must reach it, on the free dofs,
+  // the periodic pairs and the top row alike.
+  Model model;
+  model.settings.fluid_density = 1.0;  // rho_s = rho_f: no FE mass
+  BodySpec b;
+  b.name = "layer";
+  b.mesh = rectangle_mesh(0, 0, 0.25, 0.5, 4, 16, Diagonals::criss_cross);
+  b.materials = {Material{}};
+  b.materials[0].model = MaterialModel::neo_hookean;
+  b.materials[0].mu = 5;
+  b.materials[0].bulk = 500;
+  b.materials[0].density = 1;
+  Constraint per;
+  per.type = Constraint::Type::periodic;
+  per.boundary = "left";
+  per.partner = "right";
+  b.constraints = {fix("bottom", true, true), per};
+  model.bodies.push_back(b);
+  Solver s(model);
+  const Mesh& m = s.mesh(0);
+  for (double level : {1e-14, 1e-8, 1e-3}) {
+    INFO("force level " << level);
+    // A shear force on the top row, growing towards the top, as the fluid's drag.
+    std::vector<std::vector<double>> f(1, std::vector<double>(2 * m.num_nodes(), 0.0));
+    for (int n = 0; n < m.num_nodes(); ++n)
+      f[0][2 * n] = level * m.x[2 * n + 1] * m.x[2 * n + 1];
+    const StepReport r = s.advance(5e-4, &f);
+    CHECK(r.converged);
+    CHECK(r.iterations <= 4);
+    CHECK(r.residuals.back() <= r.tolerance);
+  }
+}
+
 TEST_CASE("a static body without supports is rejected", "[input]") {
   Model model;
   model.settings.analysis = Analysis::statics;
