@@ -93,8 +93,8 @@ double neo_hookean(const Material& m, const Eigen::Matrix2d& H, Eigen::Vector3d*
     // (otherwise its absolute error is eps (G + K) and Newton cannot reduce a small residual).
     const Eigen::Matrix2d E = green_lagrange(H);
     Eigen::Matrix2d IminusCi;
-    IminusCi << (2 * C(1, 1) * E(0, 0) - C(0, 1) * C(1, 0)) / detC, C(0, 1) / detC,
-        C(1, 0) / detC, (2 * C(0, 0) * E(1, 1) - C(0, 1) * C(1, 0)) / detC;
+    IminusCi << (2 * C(1, 1) * E(0, 0) - C(0, 1) * C(1, 0)) / detC, C(0, 1) / detC, C(1, 0) / detC,
+        (2 * C(0, 0) * E(1, 1) - C(0, 1) * C(1, 0)) / detC;
     for (int a = 0; a < 3; ++a) {
       const int i = voigt_i[a], j = voigt_j[a];
       (*S)(a) = G * Jm23 * (IminusCi(i, j) - tr_e2 / 3 * Ci(i, j)) + K * J * jm1 * Ci(i, j);

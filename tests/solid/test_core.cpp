@@ -310,8 +310,7 @@ TEST_CASE("a periodic massless layer starting from rest converges under a force 
     INFO("force level " << level);
     // A shear force on the top row, growing towards the top, as the fluid's drag.
     std::vector<std::vector<double>> f(1, std::vector<double>(2 * m.num_nodes(), 0.0));
-    for (int n = 0; n < m.num_nodes(); ++n)
-      f[0][2 * n] = level * m.x[2 * n + 1] * m.x[2 * n + 1];
+    for (int n = 0; n < m.num_nodes(); ++n) f[0][2 * n] = level * m.x[2 * n + 1] * m.x[2 * n + 1];
     const StepReport r = s.advance(5e-4, &f);
     CHECK(r.converged);
     CHECK(r.iterations <= 4);
