@@ -553,7 +553,9 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
       r[d] -= B.q[d];
       if (B.eq[d] >= 0) {
         m_residual[B.eq[d]] += r[d];
-        const double s = std::abs(B.f_ext[d]) + 2 * std::abs(B.f_cpl[d]) + absq[d] +
+        // The coupling force counts as it enters r: twice with mass, once on a massless dof.
+        const double w_cpl = dynamic && B.mass_row[d] > 0 ? 2.0 : 1.0;
+        const double s = std::abs(B.f_ext[d]) + w_cpl * std::abs(B.f_cpl[d]) + absq[d] +
                          (dynamic ? std::abs(B.ma[d]) : 0.0);
         scale2 += s * s;
         floor2 += (s + absm[d]) * (s + absm[d]);
