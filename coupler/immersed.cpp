@@ -80,6 +80,16 @@ void ImmersedSolid::clip_body(const FaceBoxes& boxes, int b, const std::vector<d
     const int a[3] = {tri[e], tri[e + 1], tri[e + 2]};
     Vec2 p[3];
     for (int k = 0; k < 3; ++k) p[k] = {x[2 * a[k]], x[2 * a[k] + 1]};
+    // A body may have travelled any number of periods: bring the triangle back to the period
+    // that holds its first node, then its images at ±period cover the boxes it overlaps.
+    if (boxes.period_x > 0) {
+      const double shift = boxes.period_x * std::floor((p[0].x - xlo) / boxes.period_x);
+      for (auto& q : p) q.x -= shift;
+    }
+    if (boxes.period_y > 0) {
+      const double shift = boxes.period_y * std::floor((p[0].y - ylo) / boxes.period_y);
+      for (auto& q : p) q.y -= shift;
+    }
     const double bx0 = std::min({p[0].x, p[1].x, p[2].x}), bx1 = std::max({p[0].x, p[1].x, p[2].x});
     const double by0 = std::min({p[0].y, p[1].y, p[2].y}), by1 = std::max({p[0].y, p[1].y, p[2].y});
     for (int qy = 0; qy < nsy; ++qy) {

@@ -162,6 +162,8 @@ TEST_CASE("volume fractions add up to the body's area, for u- and v-cells separa
   cases.push_back({"disk", grid(40, 32, 1.0, 0.8, false, false), d, disk_area});
   cases.push_back({"across the periodic boundaries", grid(32, 32, 1.0, 1.0, true, true),
                    rectangle(0.4, 0.25, 9, 5, 0.2, {0.97, 0.02}), 0.1});
+  cases.push_back({"travelled several periods", grid(32, 32, 1.0, 1.0, true, true),
+                   rectangle(0.4, 0.25, 9, 5, 0.2, {0.97 + 2.0, 0.02 - 3.0}), 0.1});
   cases.push_back({"stretched grid", [] {
                      auto g = grid(30, 20, 1.0, 1.0, true, false);
                      for (int j = 0; j <= 20; ++j) g.y_face[j] = std::pow(j / 20.0, 1.5);
