@@ -134,15 +134,11 @@ void Coupler::setup() {
   for (std::size_t g = 0; g < m_force_groups.size(); ++g) {
     for (const auto& name : m_force_groups[g].body_names) {
       auto it = std::find_if(bodies.begin(), bodies.end(), [&](const auto& b) { return b.name == name; });
-      if (it == bodies.end()) {
-        std::vector<std::string> names;
-        for (const auto& b : bodies) names.push_back(b.name);
+      if (it == bodies.end())
         throw fsi::InputError(fmt::format(
             "coupler.force[{}].bodies names body '{}', which the scene does not have (bodies: {}) "
             "(in {})",
-            g, name, names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", ")),
-            m_rt.scene().file().string()));
-      }
+            g, name, body_names(), m_rt.scene().file().string()));
       m_force_groups[g].bodies.push_back(static_cast<int>(it - bodies.begin()));
     }
   }
@@ -219,6 +215,16 @@ void Coupler::warn_element_sizes() const {
   }
 }
 
+// Send `in` to a solver and wait for its answer, timed as that solver's phase.
+template <class In, class Out>
+void Coupler::exchange(Role r, const In& in, Out& out, long n) {
+  m_phases.start(fsi::role_name(r));
+  auto& l = m_rt.link(r);
+  l.send(in, n);
+  l.recv(out);
+  m_phases.stop(fsi::role_name(r));
+}
+
 // One step t^n -> t^(n+1), DESIGN.md §3.
 void Coupler::step(long n) {
   const auto& s = m_rt.settings();
@@ -241,11 +247,7 @@ void Coupler::step(long n) {
   }
   // 3-4: the fluid step.
   if (has(Role::fluid)) {
-    m_phases.start("fluid");
-    auto& l = m_rt.link(Role::fluid);
-    l.send(m_fluid_in, n);
-    l.recv(m_fluid_out);
-    m_phases.stop("fluid");
+    exchange(Role::fluid, m_fluid_in, m_fluid_out, n);
     if (m_ib) {
       m_ib->store_samples(m_fluid_in.sample_u, m_fluid_out.u_sample, m_fluid_in.sample_v,
                           m_fluid_out.v_sample);
@@ -265,25 +267,24 @@ void Coupler::step(long n) {
   add_root_loads();
   // 7: the solid step.
   if (has(Role::solid)) {
-    m_phases.start("solid");
-    auto& l = m_rt.link(Role::solid);
-    l.send(m_solid_in, n);
-    l.recv(m_solid);
-    m_phases.stop("solid");
+    exchange(Role::solid, m_solid_in, m_solid, n);
     if (m_immersed) check_bodies_in_domain(n + 1);
   }
   // 8-9: the fiber step, with the root poses from the solid's new state.
   if (has(Role::fiber)) {
     root_poses(m_fiber_in.root_pose);
-    m_phases.start("fiber");
-    auto& l = m_rt.link(Role::fiber);
-    l.send(m_fiber_in, n);
-    l.recv(m_fiber);
-    m_phases.stop("fiber");
+    exchange(Role::fiber, m_fiber_in, m_fiber, n);
   }
   m_progress->update(n + 1, fsi::step_time(s, n + 1), s.dt, [&] {
     return fmt::format("CFL {:.3g}  div {:.1e}", m_fluid_out.cfl, m_fluid_out.max_div);
   });
+}
+
+// "bar, cylinder", or "none": the bodies' names for error messages.
+std::string Coupler::body_names() const {
+  std::vector<std::string> names;
+  for (const auto& b : m_meshes.bodies) names.push_back(b.name);
+  return names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", "));
 }
 
 // Attached fibers: the body by name, and the surface edge nearest to the root's reference point
@@ -295,14 +296,10 @@ void Coupler::resolve_roots() {
     const auto& f = m_layout.fibers[k];
     if (f.root != 1) continue;
     auto it = std::find_if(bodies.begin(), bodies.end(), [&](const auto& b) { return b.name == f.body; });
-    if (it == bodies.end()) {
-      std::vector<std::string> names;
-      for (const auto& b : bodies) names.push_back(b.name);
+    if (it == bodies.end())
       throw fsi::InputError(fmt::format(
           "fiber '{}' is rooted on body '{}', which the scene does not have (bodies: {}) (in {})",
-          f.name, f.body, names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", ")),
-          m_rt.scene().file().string()));
-    }
+          f.name, f.body, body_names(), m_rt.scene().file().string()));
     const auto& b = *it;
     Root r;
     r.body = static_cast<int>(it - bodies.begin());

@@ -40,6 +40,9 @@ class Coupler {
   void root_poses(std::vector<std::vector<double>>& poses) const;
   void feedback_forces();
   void add_root_loads();
+  template <class In, class Out>
+  void exchange(fsi::Role r, const In& in, Out& out, long n);
+  std::string body_names() const;
 
   // Where an attached fiber's root sits: surface edge `edge` (node a -> node b) of body `body`, at
   // parameter s along it. body < 0: the fiber is not attached to a body.

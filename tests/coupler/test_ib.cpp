@@ -4,19 +4,14 @@
 #include <cmath>
 #include <random>
 
+#include "fixtures.hpp"
 #include "ib.hpp"
 
 using namespace coupler;
+using coupler::testing::grid;
 
 namespace {
 
-proto::GridInfo grid(int nx, int ny, double lx, double ly, bool px, bool py) {
-  proto::GridInfo g;
-  g.nx = nx, g.ny = ny, g.periodic_x = px, g.periodic_y = py, g.density = 1;
-  for (int i = 0; i <= nx; ++i) g.x_face.push_back(lx * i / nx);
-  for (int j = 0; j <= ny; ++j) g.y_face.push_back(ly * j / ny);
-  return g;
-}
 
 // Face positions of the two families (u: (x_face[i], y_centre[j]), v: (x_centre[i], y_face[j])).
 void face_xy(const proto::GridInfo& g, int c, std::int32_t f, double& x, double& y) {

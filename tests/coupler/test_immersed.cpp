@@ -5,20 +5,14 @@
 #include <random>
 
 #include "clip.hpp"
+#include "fixtures.hpp"
 #include "immersed.hpp"
 
 using namespace coupler;
+using coupler::testing::grid;
 
 namespace {
 
-// A uniform grid on [0, lx] × [0, ly] with nx × ny cells.
-proto::GridInfo grid(int nx, int ny, double lx, double ly, bool px, bool py) {
-  proto::GridInfo g;
-  g.nx = nx, g.ny = ny, g.periodic_x = px, g.periodic_y = py, g.density = 1;
-  for (int i = 0; i <= nx; ++i) g.x_face.push_back(lx * i / nx);
-  for (int j = 0; j <= ny; ++j) g.y_face.push_back(ly * j / ny);
-  return g;
-}
 
 // A w × h rectangle of m × n cells, each split into two triangles, rotated by theta about its
 // centre and centred at c.
