@@ -23,7 +23,7 @@ usage: ./fsi COMMAND [ARGS]
                               mpirun job of the programs it needs; output in out/<scene name>/
   test [CTEST ARGS]           build, then run the whole test suite through CTest
   validate [CASE...]          run the validation cases in runs/ (all when none is named)
-  bench [WHAT]                run a benchmark (fluid, solid, fiber, protocol);
+  bench [WHAT]                run a benchmark (fluid, solid, fiber, coupled, protocol);
                               without WHAT, list them
   build                       install missing packages, configure and build (incremental)
   deps                        install missing Debian packages (as root) or list them
@@ -154,7 +154,7 @@ validate() {
 bench() {
   build
   local what=${1:-}
-  local available=(protocol)
+  local available=(protocol coupled)
   for b in "$BIN"/bench_*; do [ -x "$b" ] && available+=("${b##*/bench_}"); done
   if [ -z "$what" ]; then
     say "benchmarks: ${available[*]}"
@@ -163,6 +163,8 @@ bench() {
   mkdir -p "$ROOT/out/bench"
   if [ "$what" = protocol ]; then
     bench_protocol
+  elif [ "$what" = coupled ]; then
+    bench_coupled
   elif [ -x "$BIN/bench_$what" ]; then
     "$BIN/bench_$what" --out "$ROOT/out/bench/$what.json"
   else
@@ -189,6 +191,37 @@ print("  polite wait (yield, then sleep 5..200 us) instead of Open MPI's busy po
 print("  timer slack 1 us instead of Linux's 50 us | shorter wake-ups | 388 -> 174 us per empty step (one pair of runs)")
 print("  sleep cap 50 us instead of 200 us | faster hand-over | empty step 270-440 -> 133-218 us, but the default")
 print("      coupled scene 0.9-1.1 -> 1.6-1.7 s: the waiting programs steal the cores; kept at 200 us")
+PY
+}
+
+# A coupled step at the paper's Turek-Hron FSI2 resolution: the coupler's work and the message
+# traffic against the fluid step, and the whole step against the sum of its parts.
+bench_coupled() {
+  local scene=$ROOT/runs/bench-coupled/scene.toml dir=$ROOT/out/bench/coupled
+  compose "$scene" --out-dir "$dir" --overwrite
+  "${CMD[@]}"
+  /usr/bin/python3 - "$dir/summary.json" "$ROOT/out/bench/coupled.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+n = s["steps"]
+c = {k: v["seconds_per_call"] * 1e3 for k, v in s["coupler"]["phases"].items()}
+fluid = sum(s["fluid"]["phases"].values()) / n * 1e3
+traffic = c["fluid"] - fluid
+work = c.get("footprint", 0) + c.get("reaction", 0) + c.get("fibers", 0)
+step = s["coupler"]["us_per_step"] / 1e3
+parts = c["fluid"] + c.get("solid", 0) + c.get("fiber", 0) + work
+r = {"steps": n, "grid": s["fluid"].get("grid"), "ms_per_step": {
+        "whole step": step, "fluid compute": fluid, "fluid traffic and hand-over": traffic,
+        "footprint": c.get("footprint", 0), "reaction": c.get("reaction", 0),
+        "solid round trip": c.get("solid", 0)},
+     "coupler_work_and_traffic_to_fluid_step": (work + traffic) / fluid,
+     "step_to_sum_of_parts": step / parts}
+json.dump(r, open(sys.argv[2], "w"), indent=2)
+for k, v in r["ms_per_step"].items():
+    print(f"  {k:30s} {v:8.3f} ms")
+print(f"  coupler work + traffic / fluid step: {r['coupler_work_and_traffic_to_fluid_step']:.2f}"
+      " (target 0.10)")
+print(f"  whole step / sum of its parts: {r['step_to_sum_of_parts']:.3f}")
 PY
 }
 
