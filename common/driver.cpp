@@ -81,6 +81,19 @@ void follow(Runtime& rt, Port& port, Advance advance) {
   c.send(proto::Text{proto::Tag::final_report, j.dump()});
 }
 
+// The per-step exchange of a solver that reports its state (solid, fiber): its input from the
+// coupler, the step, its new state back.
+template <class Port, class In, class State>
+void follow_state(Runtime& rt, Port& port, In& in, State& st) {
+  Link& c = rt.coupler_link();
+  follow(rt, port, [&](const proto::StepBegin& sb) {
+    c.recv(in);
+    port.advance(sb, in);
+    port.state(st);
+    c.send(st, sb.step);
+  });
+}
+
 }  // namespace
 
 void serve(Runtime& rt, FluidPort& port) {
@@ -107,12 +120,7 @@ void serve(Runtime& rt, SolidPort& port) {
   c.send(port.meshes());
   port.state(st);
   c.send(st);
-  follow(rt, port, [&](const proto::StepBegin& sb) {
-    c.recv(in);
-    port.advance(sb, in);
-    port.state(st);
-    c.send(st, sb.step);
-  });
+  follow_state(rt, port, in, st);
 }
 
 void serve(Runtime& rt, FiberPort& port) {
@@ -127,12 +135,7 @@ void serve(Runtime& rt, FiberPort& port) {
   port.set_initial_roots(in.root_pose);
   port.state(st);
   c.send(st);
-  follow(rt, port, [&](const proto::StepBegin& sb) {
-    c.recv(in);
-    port.advance(sb, in);
-    port.state(st);
-    c.send(st, sb.step);
-  });
+  follow_state(rt, port, in, st);
 }
 
 }  // namespace fsi

@@ -2,6 +2,7 @@
 #include "coupler.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -43,17 +44,19 @@ void Coupler::run() {
 
 namespace {
 
-// ρ_f ∫ v dA over a body in its current configuration (v linear on each triangle).
-double body_momentum(const proto::BodyMesh& b, const std::vector<double>& x,
-                     const std::vector<double>& v, int c, double rho) {
-  double p = 0;
+// ρ_f ∫ v dA over a body in its current configuration (v linear on each triangle), both
+// components in one pass. A rigid fixed body does not move: zero without a pass.
+std::array<double, 2> body_momentum(const proto::BodyMesh& b, const std::vector<double>& x,
+                                    const std::vector<double>& v, double rho) {
+  std::array<double, 2> p{0.0, 0.0};
+  if (b.kind == 1) return p;
   for (std::size_t e = 0; e + 2 < b.tri.size(); e += 3) {
     const int i = b.tri[e], j = b.tri[e + 1], k = b.tri[e + 2];
     const double area = 0.5 * std::abs((x[2 * j] - x[2 * i]) * (x[2 * k + 1] - x[2 * i + 1]) -
                                        (x[2 * k] - x[2 * i]) * (x[2 * j + 1] - x[2 * i + 1]));
-    p += area * (v[2 * i + c] + v[2 * j + c] + v[2 * k + c]) / 3.0;
+    for (int c = 0; c < 2; ++c) p[c] += area * (v[2 * i + c] + v[2 * j + c] + v[2 * k + c]) / 3.0;
   }
-  return rho * p;
+  return {rho * p[0], rho * p[1]};
 }
 
 }  // namespace
@@ -148,10 +151,9 @@ void Coupler::setup() {
     m_probes = std::make_unique<fsi::ProbeCsv>(m_rt.out_dir() / "coupler_forces.csv", cols);
     m_probe_row.assign(cols.size(), 0.0);
   }
-  m_momentum.assign(2 * bodies.size(), 0.0);
+  m_momentum.resize(bodies.size());
   for (std::size_t b = 0; b < bodies.size(); ++b)
-    for (int c = 0; c < 2; ++c)
-      m_momentum[2 * b + c] = body_momentum(bodies[b], m_solid.x[b], m_solid.v[b], c, m_grid.density);
+    m_momentum[b] = body_momentum(bodies[b], m_solid.x[b], m_solid.v[b], m_grid.density);
 
   // The effective scene: the coupler's own reading, each solver's table from that solver.
   std::istringstream own(m_rt.scene().effective_toml());
@@ -392,20 +394,19 @@ void Coupler::write_force_probes(long n) {
   if (!m_probes) return;
   const auto& bodies = m_meshes.bodies;
   const double dt = m_rt.settings().dt;
-  std::fill(m_probe_row.begin(), m_probe_row.end(), 0.0);
-  for (std::size_t g = 0; g < m_force_groups.size(); ++g) {
-    for (int b : m_force_groups[g].bodies) {
-      for (int c = 0; c < 2; ++c) {
-        double f = 0;
-        for (std::size_t k = c; k < m_solid_in.force[b].size(); k += 2) f += m_solid_in.force[b][k];
-        const double p = body_momentum(bodies[b], m_solid.x[b], m_solid.v[b], c, m_grid.density);
-        m_probe_row[2 * g + c] += f + (p - m_momentum[2 * b + c]) / dt;
-      }
-    }
+  // Per body, once: the reaction's resultant plus the rate of the carried fluid momentum.
+  m_body_force.assign(bodies.size(), {0.0, 0.0});
+  for (std::size_t b = 0; b < bodies.size(); ++b) {
+    const auto p = body_momentum(bodies[b], m_solid.x[b], m_solid.v[b], m_grid.density);
+    const auto& f = m_solid_in.force[b];
+    for (std::size_t k = 0; k < f.size(); ++k) m_body_force[b][k % 2] += f[k];
+    for (int c = 0; c < 2; ++c) m_body_force[b][c] += (p[c] - m_momentum[b][c]) / dt;
+    m_momentum[b] = p;
   }
-  for (std::size_t b = 0; b < bodies.size(); ++b)
-    for (int c = 0; c < 2; ++c)
-      m_momentum[2 * b + c] = body_momentum(bodies[b], m_solid.x[b], m_solid.v[b], c, m_grid.density);
+  std::fill(m_probe_row.begin(), m_probe_row.end(), 0.0);
+  for (std::size_t g = 0; g < m_force_groups.size(); ++g)
+    for (int b : m_force_groups[g].bodies)
+      for (int c = 0; c < 2; ++c) m_probe_row[2 * g + c] += m_body_force[b][c];
   m_probes->write(fsi::step_time(m_rt.settings(), n + 1), m_probe_row);
 }
 

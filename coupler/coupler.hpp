@@ -3,6 +3,7 @@
 // fluid describes at set-up, and the solids and fibers only through their meshes and markers.
 #pragma once
 
+#include <array>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -81,7 +82,8 @@ class Coupler {
   std::vector<Root> m_roots;
   std::vector<double> m_u_markers;  // scratch: U(X^n) of one fiber
   std::vector<ForceGroup> m_force_groups;
-  std::vector<double> m_momentum;   // per body: ρ_f ∫ v dA at the last state (for the force probe)
+  std::vector<std::array<double, 2>> m_momentum;    // per body: ρ_f ∫ v dA at the last probe
+  std::vector<std::array<double, 2>> m_body_force;  // per body: hydrodynamic force of this step
   std::unique_ptr<fsi::ProbeCsv> m_probes;
   std::vector<double> m_probe_row;
   std::unique_ptr<fsi::Progress> m_progress;
