@@ -39,7 +39,7 @@ FeedbackIB::FeedbackIB(const proto::GridInfo& g) {
   for (Family* f : {&m_u, &m_v}) {
     f->px = g.periodic_x != 0, f->py = g.periodic_y != 0;
     const std::size_t n = static_cast<std::size_t>(f->ni) * f->nj;
-    f->value.assign(n, 0.0), f->has_value.assign(n, 0), f->force.assign(n, 0.0);
+    f->value.assign(n, 0.0), f->has_value.assign(n, 0), f->force.assign(n, 0.0), f->mark.assign(n, 0);
   }
 }
 
@@ -66,26 +66,37 @@ void FeedbackIB::kernel(const Family& f, double X, double Y, std::int32_t idx[16
 }
 
 void FeedbackIB::stencil(const std::vector<std::vector<double>>& markers, int margin,
-                         std::vector<std::int32_t>& u_faces, std::vector<std::int32_t>& v_faces) const {
+                         std::vector<std::int32_t>& u_faces, std::vector<std::int32_t>& v_faces) {
+  // Neighbouring markers share most of their windows: each face is listed once through a mark
+  // per face (cleared again from the list), so only the distinct faces are sorted.
   for (auto [f, out] : {std::pair{&m_u, &u_faces}, std::pair{&m_v, &v_faces}}) {
     out->clear();
     for (const auto& x : markers) {
+      int ic_prev = 0, jc_prev = 0;
       for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
         const int ic = static_cast<int>(std::floor((x[m] - f->x0) / m_hx));
         const int jc = static_cast<int>(std::floor((x[m + 1] - f->y0) / m_hy));
-        for (int j = jc - 1 - margin; j <= jc + 2 + margin; ++j)
+        // Markers closer than a cell often share their cell, and so their window.
+        if (m > 0 && ic == ic_prev && jc == jc_prev) continue;
+        ic_prev = ic, jc_prev = jc;
+        for (int j = jc - 1 - margin; j <= jc + 2 + margin; ++j) {
+          int b = j;
+          if (f->py) b = ((b % f->nj) + f->nj) % f->nj;
+          else if (b < 0 || b >= f->nj) continue;
           for (int i = ic - 1 - margin; i <= ic + 2 + margin; ++i) {
-            int a = i, b = j;
+            int a = i;
             if (f->px) a = ((a % f->ni) + f->ni) % f->ni;
             else if (a < 0 || a >= f->ni) continue;
-            if (f->py) b = ((b % f->nj) + f->nj) % f->nj;
-            else if (b < 0 || b >= f->nj) continue;
-            out->push_back(a + f->ni * b);
+            const std::int32_t k = a + f->ni * b;
+            if (f->mark[k]) continue;
+            f->mark[k] = 1;
+            out->push_back(k);
           }
+        }
       }
     }
+    for (const std::int32_t k : *out) f->mark[k] = 0;
     std::sort(out->begin(), out->end());
-    out->erase(std::unique(out->begin(), out->end()), out->end());
   }
 }
 

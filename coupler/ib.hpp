@@ -29,7 +29,7 @@ class FeedbackIB {
   // sorted: the faces whose velocity the coupler asks the fluid for. Faces on a non-periodic
   // boundary are included (they hold boundary values).
   void stencil(const std::vector<std::vector<double>>& markers, int margin,
-               std::vector<std::int32_t>& u_faces, std::vector<std::int32_t>& v_faces) const;
+               std::vector<std::int32_t>& u_faces, std::vector<std::int32_t>& v_faces);
 
   // Remember sampled face velocities (the fluid's answer to a stencil request).
   void store_samples(const std::vector<std::int32_t>& u_faces, const std::vector<double>& u,
@@ -59,6 +59,7 @@ class FeedbackIB {
     std::vector<char> has_value;
     std::vector<double> force;   // spread force per face
     std::vector<std::int32_t> touched;
+    std::vector<char> mark;      // scratch of stencil(): face already listed
   };
   // The 4 × 4 kernel of point (X, Y) on a family: face indices (−1 outside a bounded grid) and
   // weights φ φ.
