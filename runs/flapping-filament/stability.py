@@ -103,11 +103,6 @@ rectangle = {{ origin = [0.4, 0.3], size = [0.2, 0.1], cells = [8, 4] }}
 center = [0.5, 0.35]
 amplitude = [0.0, 0.1]
 frequency = 4.7746
-[[solid.body.material]]
-model = "neo-hookean"
-density = 2.0
-shear_modulus = 10.0
-bulk_modulus = 100.0
 [fiber]
 substeps = {sub}
 [[fiber.fiber]]
