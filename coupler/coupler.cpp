@@ -27,6 +27,20 @@ Coupler::Coupler(fsi::Runtime& rt) : m_rt(rt) {
     m_kappa_given = c->has("kappa");
     if (m_kappa_given) m_kappa = c->positive("kappa");
     m_kappa_gain = c->in_range("kappa_gain", 0.0, 2.0, true, 0.5);
+    if (const auto d = c->optional_table("diagnostics")) {
+      m_log_csv = d->boolean("exchange", false);
+      m_dump_every = d->integer("dump_every", 0);
+      if (m_dump_every < 0)
+        d->fail("dump_every", fmt::format("must be >= 0 (0: no dump), got {}", m_dump_every));
+      d->finish();
+    }
+    if (const auto h = c->optional_table("health")) {
+      m_growth_factor = h->number("growth_factor", m_growth_factor);
+      if (!(m_growth_factor > 1))
+        h->fail("growth_factor", fmt::format("must be > 1, got {}", m_growth_factor));
+      m_growth_steps = h->positive_integer("growth_steps", m_growth_steps);
+      h->finish();
+    }
     c->finish();
   }
 }
@@ -151,6 +165,14 @@ void Coupler::setup() {
     m_probes = std::make_unique<fsi::ProbeCsv>(m_rt.out_dir() / "coupler_forces.csv", cols);
     m_probe_row.assign(cols.size(), 0.0);
   }
+  if (m_log_csv || m_dump_every > 0)
+    m_log = std::make_unique<ExchangeLog>(m_rt.out_dir(), m_grid, m_meshes, m_layout,
+                                          m_rt.settings().dt, m_log_csv, m_dump_every);
+  if (m_ib) check_fibers_in_domain(0);
+  m_energy.assign(bodies.size(), 0.0);
+  m_growing.assign(bodies.size(), 0);
+  m_velocity.assign(bodies.size(), {});
+  check_growth(0);
   m_momentum.resize(bodies.size());
   for (std::size_t b = 0; b < bodies.size(); ++b)
     m_momentum[b] = body_momentum(bodies[b], m_solid.x[b], m_solid.v[b], m_grid.density);
@@ -183,6 +205,76 @@ void Coupler::check_bodies_in_domain(long step) const {
                   "boundary at step {}: node {} at ({}, {})",
                   m_meshes.bodies[b].name, x0, x1, y0, y1, side, step, k / 2, x[k], x[k + 1]);
     }
+  }
+}
+
+// A fiber must stay inside the fluid domain, except across a periodic boundary: outside, its
+// markers would neither feel the fluid nor act on it.
+void Coupler::check_fibers_in_domain(long step) const {
+  const double x0 = m_grid.x_face.front(), x1 = m_grid.x_face.back();
+  const double y0 = m_grid.y_face.front(), y1 = m_grid.y_face.back();
+  for (std::size_t k = 0; k < m_fiber.x.size() && k < m_layout.fibers.size(); ++k) {
+    const auto& x = m_fiber.x[k];
+    for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
+      const char* side = nullptr;
+      if (!m_grid.periodic_x && x[m] < x0) side = "left";
+      else if (!m_grid.periodic_x && x[m] > x1) side = "right";
+      else if (!m_grid.periodic_y && x[m + 1] < y0) side = "bottom";
+      else if (!m_grid.periodic_y && x[m + 1] > y1) side = "top";
+      if (side)
+        fsi::fail("fiber '{}' left the fluid domain [{}, {}] x [{}, {}] through its {} boundary "
+                  "at step {}: marker {} at ({:.6g}, {:.6g})",
+                  m_layout.fibers[k].name, x0, x1, y0, y1, side, step, m / 2, x[m], x[m + 1]);
+    }
+  }
+}
+
+// The explicit coupling of a body light against the fluid can be unstable at a given Δt: the
+// fluid's reaction overshoots the body's own inertia, the motion reverses and grows every step
+// (an amplification factor below −1), and the solid or the fluid fails a few steps later far
+// from the cause. Caught here from each elastic body's velocity v (linear on each triangle T,
+// integrals exact with ∫_T N_a N_b dA = |T| (1 + δ_ab)/12):
+//   E = ½ ∫ |v|² dA = Σ_T |T|/24 (Σ_a |v_a|² + |Σ_a v_a|²)          (kinetic energy / density)
+//   C = ∫ vⁿ⁺¹·vⁿ dA = Σ_T |T|/12 (Σ_a vⁿ⁺¹_a·vⁿ_a + Σ_a vⁿ⁺¹_a · Σ_a vⁿ_a)
+// A step with E grown by more than coupler.health.growth_factor and C < 0 (the velocity field
+// reversed) is a growth step; growth_steps of them in a row stop the run. Physical motion does
+// not reverse at every step of the time discretisation while it grows.
+void Coupler::check_growth(long step) {
+  for (std::size_t b = 0; b < m_meshes.bodies.size() && b < m_solid.x.size(); ++b) {
+    const auto& body = m_meshes.bodies[b];
+    if (body.kind != 0) continue;
+    const auto& x = m_solid.x[b];
+    const auto& v = m_solid.v[b];
+    auto& vo = m_velocity[b];
+    const bool has_old = vo.size() == v.size();
+    double e = 0, c = 0;
+    for (std::size_t t = 0; t + 2 < body.tri.size(); t += 3) {
+      const int i = body.tri[t], j = body.tri[t + 1], k = body.tri[t + 2];
+      const double area = 0.5 * std::abs((x[2 * j] - x[2 * i]) * (x[2 * k + 1] - x[2 * i + 1]) -
+                                         (x[2 * k] - x[2 * i]) * (x[2 * j + 1] - x[2 * i + 1]));
+      double sq = 0, cr = 0;
+      for (int d = 0; d < 2; ++d) {
+        const double a = v[2 * i + d], bb = v[2 * j + d], cc = v[2 * k + d];
+        sq += a * a + bb * bb + cc * cc + (a + bb + cc) * (a + bb + cc);
+        if (has_old) {
+          const double ao = vo[2 * i + d], bo = vo[2 * j + d], co = vo[2 * k + d];
+          cr += a * ao + bb * bo + cc * co + (a + bb + cc) * (ao + bo + co);
+        }
+      }
+      e += area / 24.0 * sq;
+      c += area / 12.0 * cr;
+    }
+    const double before = m_energy[b];
+    const bool grew = has_old && before > 0 && e > m_growth_factor * before && c < 0;
+    m_growing[b] = grew ? m_growing[b] + 1 : 0;
+    m_energy[b] = e;
+    vo = v;
+    if (m_growing[b] >= m_growth_steps)
+      fsi::fail("body '{}' is unstable at step {}: its kinetic energy per unit density "
+                "1/2 int |v|^2 dA = {:.3g} grew by more than a factor {} and its velocity "
+                "reversed in each of the last {} steps: the explicit coupling cannot hold this "
+                "time.dt = {} (lower it, or make the body heavier)",
+                body.name, step, e, m_growth_factor, m_growth_steps, m_rt.settings().dt);
   }
 }
 
@@ -247,6 +339,8 @@ void Coupler::step(long n) {
     feedback_forces();
     m_phases.stop("fibers");
   }
+  if (m_log)
+    m_log->inputs(n, sb.time, m_solid, m_fiber, m_fluid_in, m_fiber_in, m_ib.get(), m_have_samples);
   // 3-4: the fluid step.
   if (has(Role::fluid)) {
     exchange(Role::fluid, m_fluid_in, m_fluid_out, n);
@@ -262,21 +356,30 @@ void Coupler::step(long n) {
     m_immersed->reaction(m_fluid_out.fs_u, m_fluid_out.fs_v, m_solid_in.force);
     m_phases.stop("reaction");
   }
+  if (m_log) m_log->reaction(m_fluid_in, m_fluid_out, m_solid_in.force);
   write_force_probes(n);
   // Rigid bodies move by their law: their reaction is only measured, not sent.
   for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
     if (m_meshes.bodies[b].kind != 0) m_solid_in.force[b].clear();
+  if (m_log) {
+    m_log->before_root_loads(m_solid_in.force);
+    root_poses(m_log_poses);
+  }
   add_root_loads();
+  if (m_log) m_log->root_loads(m_solid_in.force, m_fiber.root_load, m_log_poses);
   // 7: the solid step.
   if (has(Role::solid)) {
     exchange(Role::solid, m_solid_in, m_solid, n);
     if (m_immersed) check_bodies_in_domain(n + 1);
+    check_growth(n + 1);
   }
   // 8-9: the fiber step, with the root poses from the solid's new state.
   if (has(Role::fiber)) {
     root_poses(m_fiber_in.root_pose);
     exchange(Role::fiber, m_fiber_in, m_fiber, n);
+    if (m_ib) check_fibers_in_domain(n + 1);
   }
+  if (m_log) m_log->end_step();
   m_progress->update(n + 1, fsi::step_time(s, n + 1), s.dt, [&] {
     return fmt::format("CFL {:.3g}  div {:.1e}", m_fluid_out.cfl, m_fluid_out.max_div);
   });

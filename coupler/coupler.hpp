@@ -10,6 +10,7 @@
 
 #include <memory>
 
+#include "exchange_log.hpp"
 #include "ib.hpp"
 #include "immersed.hpp"
 #include "probes.hpp"
@@ -35,6 +36,8 @@ class Coupler {
   void finish();
   bool has(fsi::Role r) const { return m_rt.roles()[r]; }
   void check_bodies_in_domain(long step) const;
+  void check_fibers_in_domain(long step) const;
+  void check_growth(long step);
   void warn_element_sizes() const;
   void write_force_probes(long step);
   void resolve_roots();
@@ -87,6 +90,18 @@ class Coupler {
   std::unique_ptr<fsi::ProbeCsv> m_probes;
   std::vector<double> m_probe_row;
   std::unique_ptr<fsi::Progress> m_progress;
+  // [coupler.diagnostics]: the exchange log (null when off) and its settings.
+  std::unique_ptr<ExchangeLog> m_log;
+  bool m_log_csv = false;
+  long m_dump_every = 0;
+  std::vector<std::vector<double>> m_log_poses;  // scratch: root poses at t^n for the log
+  // Growth check of the explicit coupling (check_growth): per body, the kinetic energy per unit
+  // density and the node velocities of the previous step, and how many growth steps in a row.
+  double m_growth_factor = 2.0;
+  long m_growth_steps = 3;
+  std::vector<double> m_energy;
+  std::vector<std::vector<double>> m_velocity;
+  std::vector<long> m_growing;
   fsi::PhaseTimer m_phases;
   double m_t_start = 0;
 };

@@ -2,17 +2,20 @@
 """Run one command (usually an mpirun MPMD job) as a test and check its outcome.
 
   run_job.py [--expect-fail] [--regex R]... [--absent R]... [--within S] [--timeout S]
-             [--cwd DIR] [--file-exists F]... -- COMMAND...
+             [--cwd DIR] [--file-exists F]... [--csv-max-abs F:C:L]... [--post CMD]...
+             -- COMMAND...
 
 Passes when the exit code is 0 (or non-zero with --expect-fail), every --regex matches the
 combined stdout+stderr, no --absent pattern matches, the job ended within --within seconds,
 every --file-exists path exists afterwards, and for every --csv-max-abs FILE:COLUMN_REGEX:LIMIT
 the largest |value| of the matching columns of that CSV (header line, then numbers) is at most
-LIMIT. The output is printed in any case.
+LIMIT, and every --post command (a command line, run in --cwd after the job) exits 0. The
+output is printed in any case.
 """
 import argparse
 import os
 import re
+import shlex
 import subprocess
 import sys
 import time
@@ -28,6 +31,7 @@ def main():
     p.add_argument("--cwd", default=None)
     p.add_argument("--file-exists", action="append", default=[])
     p.add_argument("--csv-max-abs", action="append", default=[])
+    p.add_argument("--post", action="append", default=[])
     p.add_argument("command", nargs=argparse.REMAINDER)
     a = p.parse_args()
     cmd = a.command[1:] if a.command and a.command[0] == "--" else a.command
@@ -83,6 +87,12 @@ def main():
         print(f"{fname}: max |{col_rx}| = {worst:.3e} over {rows} rows (limit {limit})")
         if rows == 0 or not worst <= float(limit):
             problems.append(f"{fname}: max |{col_rx}| = {worst:.3e} over {rows} rows, limit {limit}")
+    for post in a.post:
+        r = subprocess.run(shlex.split(post), cwd=a.cwd, stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+        print(r.stdout.decode(errors="replace"))
+        if r.returncode != 0:
+            problems.append(f"post-check failed (exit {r.returncode}): {post}")
     for pr in problems:
         print("FAIL:", pr)
     return 1 if problems else 0

@@ -1,0 +1,17 @@
+// A disk of radius 0.12 centred at (0.3, 0.3), element size lc: a curved body for the coupler's
+// exchange tests.
+DefineConstant[ lc = 0.04 ];
+r = 0.12; cx = 0.3; cy = 0.3;
+Point(1) = {cx, cy, 0, lc};
+Point(2) = {cx + r, cy, 0, lc};
+Point(3) = {cx, cy + r, 0, lc};
+Point(4) = {cx - r, cy, 0, lc};
+Point(5) = {cx, cy - r, 0, lc};
+Circle(1) = {2, 1, 3};
+Circle(2) = {3, 1, 4};
+Circle(3) = {4, 1, 5};
+Circle(4) = {5, 1, 2};
+Curve Loop(1) = {1, 2, 3, 4};
+Plane Surface(1) = {1};
+Physical Surface("disk") = {1};
+Physical Curve("surface") = {1, 2, 3, 4};
