@@ -16,9 +16,10 @@ dump_every > 0) and scene.effective.toml. Checks (each over every dumped step fr
                 elastic body the FE field (linear on each triangle) at that centroid; relative to
                 the largest node speed.
   solid-forces  Σ_a F_a + Σ_V f_s |V| = 0 relative to Σ_V |f_s| |V| (which must be > 0).
-  fiber-velocity  the fluid's samples u^n equal the linear field u = U0 + G x at their faces, and
-                U(X^n) at every marker equals it at the marker; relative to the largest |u| of
-                the field on the markers.
+  fluid-field   the fluid's samples u^n (the faces U(X^n) is interpolated from) equal the linear
+                field u = U0 + G x (--field) at their faces: the fluid holds it (else the next
+                check tests nothing); relative to the largest |u| of the field on the markers.
+  fiber-velocity  U(X^n) at every marker equals the field there; same scale.
   fiber-forces  Σ f_f h_x h_y (on the fluid) = −Σ_m F_m w_m (on the fibers; w = ds, ds/2 at the
                 ends), relative to Σ |F| w (which must be > 0).
   root-loads    the nodal forces that carry each fiber's root load to its body have the load's
@@ -284,7 +285,9 @@ def check_solid_forces(run, steps):
         yield s, err, f"sum F_a = ({nodal[0]:.6g}, {nodal[1]:.6g}), sum f_s|V| = ({fluid[0]:.6g}, {fluid[1]:.6g})"
 
 
-def check_fiber_velocity(run, steps, field):
+def check_fiber_velocity(run, steps, field, on_markers):
+    """on_markers False: the fluid's samples u^n equal the field on their faces (the fluid holds
+    it; without this the marker check would test nothing). True: U(X^n) equals it at the markers."""
     u0, g = np.array(field[:2]), np.array(field[2:]).reshape(2, 2)
     def exact(x, y):
         return u0 + g @ np.array([x, y])
@@ -295,23 +298,24 @@ def check_fiber_velocity(run, steps, field):
         for f in run.fibers:
             X = run.get(s, f"fiber_{f}/x").reshape(-1, 2)
             scale = max([scale] + [np.abs(exact(*p)).max() for p in X])
-        # the fluid holds the field on every sampled face (else the test tests nothing)
         worst, note = 0.0, ""
-        for k, c in enumerate("uv"):
-            for face, val in zip(run.get(s, f"samples_{c}/index", int), run.get(s, f"samples_{c}/value")):
-                want = exact(*run.fam[c].position(face))[k]
-                err = abs(val - want) / scale
-                if err >= worst:
-                    worst, note = err, f"fluid sample {c}-face {face}: {val:.15g}, field {want:.15g}"
-        yield s, worst, note
-        worst, note = 0.0, ""
+        if not on_markers:
+            for k, c in enumerate("uv"):
+                for face, val in zip(run.get(s, f"samples_{c}/index", int), run.get(s, f"samples_{c}/value")):
+                    want = exact(*run.fam[c].position(face))[k]
+                    err = abs(val - want) / scale
+                    if err >= worst:
+                        worst, note = err, f"fluid sample {c}-face {face}: {val:.15g}, field {want:.15g}"
+            yield s, worst, note
+            continue
         for f in run.fibers:
             X = run.get(s, f"fiber_{f}/x").reshape(-1, 2)
             U = run.get(s, f"fiber_{f}/u").reshape(-1, 2)
             for m, (p, u) in enumerate(zip(X, U)):
                 err = np.abs(u - exact(*p)).max() / scale
                 if err >= worst:
-                    worst, note = err, f"fiber {f} marker {m} at ({p[0]:.6g}, {p[1]:.6g}): U = ({u[0]:.15g}, {u[1]:.15g})"
+                    worst, note = err, (f"fiber {f} marker {m} at ({p[0]:.6g}, {p[1]:.6g}): "
+                                        f"U = ({u[0]:.15g}, {u[1]:.15g})")
         yield s, worst, note
 
 
@@ -367,7 +371,7 @@ def main():
     p.add_argument("run_dir")
     p.add_argument("--check", action="append", required=True,
                    choices=["areas", "fractions", "solid-velocity", "solid-forces",
-                            "fiber-velocity", "fiber-forces", "root-loads"])
+                            "fluid-field", "fiber-velocity", "fiber-forces", "root-loads"])
     p.add_argument("--tol", type=float, default=1e-12)
     p.add_argument("--from-step", type=int, default=0)
     p.add_argument("--field", default="0,0,0,0,0,0")
@@ -379,7 +383,8 @@ def main():
               "fractions": lambda: check_fractions(run, steps),
               "solid-velocity": lambda: check_solid_velocity(run, steps),
               "solid-forces": lambda: check_solid_forces(run, steps),
-              "fiber-velocity": lambda: check_fiber_velocity(run, steps, field),
+              "fluid-field": lambda: check_fiber_velocity(run, steps, field, False),
+              "fiber-velocity": lambda: check_fiber_velocity(run, steps, field, True),
               "fiber-forces": lambda: check_fiber_forces(run, steps),
               "root-loads": lambda: check_root_loads(run, steps)}
     failed = False
