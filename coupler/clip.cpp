@@ -44,6 +44,27 @@ int clip_triangle_box(const Vec2 tri[3], double x0, double x1, double y0, double
   return n;
 }
 
+void split_polygon(const Vec2* p, int n, bool is_x, double c, Vec2* below, int& nb, Vec2* above,
+                   int& na) {
+  nb = na = 0;
+  for (int k = 0; k < n; ++k) {
+    const Vec2 a = p[k];
+    const Vec2 b = p[k + 1 == n ? 0 : k + 1];
+    const double da = (is_x ? a.x : a.y) - c;
+    const double db = (is_x ? b.x : b.y) - c;
+    if (da <= 0) below[nb++] = a;
+    if (da >= 0) above[na++] = a;
+    if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
+      const double t = da / (da - db);
+      Vec2 q{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
+      if (is_x) q.x = c;
+      else q.y = c;
+      below[nb++] = q;
+      above[na++] = q;
+    }
+  }
+}
+
 PolygonMoments polygon_moments(const Vec2* p, int n) {
   // Coordinates relative to the first vertex keep the cross products small (less cancellation).
   double a2 = 0, cx = 0, cy = 0;

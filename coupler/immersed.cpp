@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include "clip.hpp"
 #include "error.hpp"
@@ -62,7 +63,9 @@ FaceBoxes FaceBoxes::v_faces(const proto::GridInfo& g) {
 
 ImmersedSolid::ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshes& meshes)
     : m_meshes(meshes), m_ub(FaceBoxes::u_faces(grid)), m_vb(FaceBoxes::v_faces(grid)) {
-  m_slot.assign(static_cast<std::size_t>(std::max(m_ub.ni * m_ub.nj, m_vb.ni * m_vb.nj)), -1);
+  m_scratch_u.slot.assign(static_cast<std::size_t>(m_ub.ni * m_ub.nj), -1);
+  m_scratch_v.slot.assign(static_cast<std::size_t>(m_vb.ni * m_vb.nj), -1);
+  m_threads = std::thread::hardware_concurrency() > 1;
 }
 
 // Every triangle of body b at positions x, against every box its bounding box meets (and its
@@ -75,7 +78,7 @@ void ImmersedSolid::clip_body(const FaceBoxes& boxes, int b, const std::vector<d
   const int nsx = boxes.period_x > 0 ? 3 : 1, nsy = boxes.period_y > 0 ? 3 : 1;
   const double xlo = boxes.ex[boxes.i_lo], xhi = boxes.ex[boxes.i_hi];
   const double ylo = boxes.ey[boxes.j_lo], yhi = boxes.ey[boxes.j_hi];
-  Vec2 poly[7], t[3];
+  Vec2 t[3];
   for (std::size_t e = 0; e + 2 < tri.size(); e += 3) {
     const int a[3] = {tri[e], tri[e + 1], tri[e + 2]};
     Vec2 p[3];
@@ -105,22 +108,51 @@ void ImmersedSolid::clip_body(const FaceBoxes& boxes, int b, const std::vector<d
             boxes.j_lo, std::upper_bound(boxes.ey.begin(), boxes.ey.end(), y0) - boxes.ey.begin() - 1);
         const int j1 = std::min<int>(
             boxes.j_hi - 1, std::lower_bound(boxes.ey.begin(), boxes.ey.end(), y1) - boxes.ey.begin() - 1);
-        for (int j = j0; j <= j1; ++j) {
-          for (int i = i0; i <= i1; ++i) {
-            const int n = clip_triangle_box(t, boxes.ex[i], boxes.ex[i + 1], boxes.ey[j],
-                                            boxes.ey[j + 1], poly);
-            if (n < 3) continue;
-            const PolygonMoments m = polygon_moments(poly, n);
-            const double area = std::abs(m.area);
-            if (area == 0) continue;
-            double N[3];
-            barycentric(t, m.centroid, N);
-            for (int k = 0; k < 3; ++k) {
-              raw.face.push_back(i + boxes.ni * j);
-              raw.body.push_back(b);
-              raw.node.push_back(a[k]);
-              raw.weight.push_back(area * N[k]);
-            }
+        if (i0 > i1 || j0 > j1) continue;
+        auto emit = [&](const Vec2* poly, int n, int i, int j) {
+          if (n < 3) return;
+          const PolygonMoments m = polygon_moments(poly, n);
+          const double area = std::abs(m.area);
+          if (area == 0) return;
+          double N[3];
+          barycentric(t, m.centroid, N);
+          for (int k = 0; k < 3; ++k) {
+            raw.face.push_back(i + boxes.ni * j);
+            raw.body.push_back(b);
+            raw.node.push_back(a[k]);
+            raw.weight.push_back(area * N[k]);
+          }
+        };
+        // Inside one box: the piece is the whole triangle.
+        if (i0 == i1 && j0 == j1 && x0 >= boxes.ex[i0] && x1 <= boxes.ex[i0 + 1] &&
+            y0 >= boxes.ey[j0] && y1 <= boxes.ey[j0 + 1]) {
+          emit(t, 3, i0, j0);
+          continue;
+        }
+        // Columns: cut the triangle at the box edges ex[i0] .. ex[i1 + 1], then each column at
+        // ey[j0] .. ey[j1 + 1] (split_polygon); parts outside [i0, i1] × [j0, j1] are dropped.
+        Vec2 s1[kMaxSplit], s2[kMaxSplit], col[kMaxSplit], c1[kMaxSplit], c2[kMaxSplit];
+        Vec2 piece[kMaxSplit], drop[kMaxSplit];
+        int nr = 3, nd = 0;
+        Vec2* rem = s1;
+        Vec2* spare = s2;
+        for (int k = 0; k < 3; ++k) rem[k] = t[k];
+        split_polygon(rem, nr, true, boxes.ex[i0], drop, nd, spare, nr);
+        std::swap(rem, spare);
+        for (int i = i0; i <= i1 && nr >= 3; ++i) {
+          int nc = 0;
+          split_polygon(rem, nr, true, boxes.ex[i + 1], col, nc, spare, nr);
+          std::swap(rem, spare);
+          if (nc < 3) continue;
+          Vec2* crem = c1;
+          Vec2* cspare = c2;
+          int ncr = 0;
+          split_polygon(col, nc, false, boxes.ey[j0], drop, nd, crem, ncr);
+          for (int j = j0; j <= j1 && ncr >= 3; ++j) {
+            int np = 0;
+            split_polygon(crem, ncr, false, boxes.ey[j + 1], piece, np, cspare, ncr);
+            std::swap(crem, cspare);
+            emit(piece, np, i, j);
           }
         }
       }
@@ -129,8 +161,9 @@ void ImmersedSolid::clip_body(const FaceBoxes& boxes, int b, const std::vector<d
 }
 
 // Sort the pieces by face (a counting sort over the touched faces only).
-void ImmersedSolid::gather(const FaceBoxes& boxes, const Raw& fixed, const Raw& moving, Pieces& p) {
-  (void)boxes;
+void ImmersedSolid::gather(const Raw& fixed, const Raw& moving, Pieces& p, Scratch& s) {
+  auto& m_slot = s.slot;
+  auto& m_count = s.count;
   p.face.clear();
   for (const Raw* r : {&fixed, &moving})
     for (const std::int32_t f : r->face)
@@ -180,25 +213,29 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
   const auto& bodies = m_meshes.bodies;
   if (state.x.size() != bodies.size() || state.v.size() != bodies.size())
     fsi::fail("solid state has {} bodies, the meshes {}", state.x.size(), bodies.size());
-  if (!m_fixed_done) {
-    for (int b = 0; b < static_cast<int>(bodies.size()); ++b) {
-      if (bodies[b].kind != 1) continue;
-      clip_body(m_ub, b, state.x[b], m_fixed_u);
-      clip_body(m_vb, b, state.x[b], m_fixed_v);
-    }
-    m_fixed_done = true;
+  // The two families are independent (own boxes, pieces and scratch): the v-family runs on a
+  // second thread while this one does the u-family. The other programs wait for this step's
+  // messages meanwhile, so the second core is free.
+  auto family = [&](const FaceBoxes& boxes, Raw& fixed, Raw& raw, Pieces& p, Scratch& s, int c,
+                    proto::FaceSolid& out) {
+    if (!m_fixed_done)
+      for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
+        if (bodies[b].kind == 1) clip_body(boxes, b, state.x[b], fixed);
+    raw.clear();
+    for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
+      if (bodies[b].kind != 1) clip_body(boxes, b, state.x[b], raw);
+    gather(fixed, raw, p, s);
+    fill(boxes, p, state, c, out);
+  };
+  if (m_threads) {
+    std::thread second([&] { family(m_vb, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v); });
+    family(m_ub, m_fixed_u, m_raw_u, m_u, m_scratch_u, 0, u);
+    second.join();
+  } else {
+    family(m_ub, m_fixed_u, m_raw_u, m_u, m_scratch_u, 0, u);
+    family(m_vb, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v);
   }
-  m_raw_u.clear();
-  m_raw_v.clear();
-  for (int b = 0; b < static_cast<int>(bodies.size()); ++b) {
-    if (bodies[b].kind == 1) continue;
-    clip_body(m_ub, b, state.x[b], m_raw_u);
-    clip_body(m_vb, b, state.x[b], m_raw_v);
-  }
-  gather(m_ub, m_fixed_u, m_raw_u, m_u);
-  gather(m_vb, m_fixed_v, m_raw_v, m_v);
-  fill(m_ub, m_u, state, 0, u);
-  fill(m_vb, m_v, state, 1, v);
+  m_fixed_done = true;
 }
 
 void ImmersedSolid::reaction(const std::vector<double>& fs_u, const std::vector<double>& fs_v,

@@ -68,7 +68,10 @@ class ImmersedSolid {
     void clear() { face.clear(), body.clear(), node.clear(), weight.clear(); }
   };
   void clip_body(const FaceBoxes& boxes, int b, const std::vector<double>& x, Raw& raw) const;
-  void gather(const FaceBoxes& boxes, const Raw& fixed, const Raw& moving, Pieces& p);
+  struct Scratch {  // per face of a family: -1, or its slot while gather() runs; counters
+    std::vector<std::int32_t> slot, count;
+  };
+  void gather(const Raw& fixed, const Raw& moving, Pieces& p, Scratch& s);
   void fill(const FaceBoxes& boxes, const Pieces& p, const proto::SolidState& state, int component,
             proto::FaceSolid& out) const;
 
@@ -77,7 +80,8 @@ class ImmersedSolid {
   Raw m_fixed_u, m_fixed_v, m_raw_u, m_raw_v;  // rigid fixed bodies' pieces, clipped once
   bool m_fixed_done = false;
   Pieces m_u, m_v;
-  std::vector<std::int32_t> m_slot, m_count;   // per face of a family: scratch for gather()
+  Scratch m_scratch_u, m_scratch_v;
+  bool m_threads = false;  // the two families on two threads (more than one core)
 };
 
 }  // namespace coupler
