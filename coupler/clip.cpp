@@ -3,47 +3,6 @@
 
 namespace coupler {
 
-namespace {
-
-// Clip polygon `in` (n vertices) against the half-plane s·(p_axis) <= s·c, i.e. keep
-// p_axis <= c when s = +1 and p_axis >= c when s = −1. A vertex exactly on the line is kept;
-// an edge crossing the line contributes the crossing point, found by linear interpolation along
-// the crossing coordinate so that it lies exactly on the line.
-int clip_half_plane(const Vec2* in, int n, bool is_x, double c, double s, Vec2* out) {
-  int m = 0;
-  for (int k = 0; k < n; ++k) {
-    const Vec2 a = in[k];
-    const Vec2 b = in[(k + 1) % n];
-    const double da = s * ((is_x ? a.x : a.y) - c);  // <= 0: inside
-    const double db = s * ((is_x ? b.x : b.y) - c);
-    if (da <= 0) out[m++] = a;
-    if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
-      const double t = da / (da - db);
-      Vec2 p{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
-      if (is_x) p.x = c;
-      else p.y = c;
-      out[m++] = p;
-    }
-  }
-  return m;
-}
-
-}  // namespace
-
-int clip_triangle_box(const Vec2 tri[3], double x0, double x1, double y0, double y1, Vec2 out[7]) {
-  // A triangle clipped by four half-planes has at most 3 + 4 = 7 vertices.
-  Vec2 a[8], b[8];
-  int n = clip_half_plane(tri, 3, true, x0, -1.0, a);
-  if (n == 0) return 0;
-  n = clip_half_plane(a, n, true, x1, 1.0, b);
-  if (n == 0) return 0;
-  n = clip_half_plane(b, n, false, y0, -1.0, a);
-  if (n == 0) return 0;
-  n = clip_half_plane(a, n, false, y1, 1.0, b);
-  for (int k = 0; k < n; ++k) out[k] = b[k];
-  return n;
-}
-
 void split_polygon(const Vec2* p, int n, bool is_x, double c, Vec2* below, int& nb, Vec2* above,
                    int& na) {
   nb = na = 0;
@@ -63,6 +22,23 @@ void split_polygon(const Vec2* p, int n, bool is_x, double c, Vec2* below, int& 
       above[na++] = q;
     }
   }
+}
+
+int clip_triangle_box(const Vec2 tri[3], double x0, double x1, double y0, double y1, Vec2 out[7]) {
+  // Four splits, keeping the side of the box each time; a triangle clipped by four half-planes
+  // has at most 3 + 4 = 7 vertices.
+  Vec2 a[kMaxSplit], b[kMaxSplit], drop[kMaxSplit];
+  int na = 0, nb = 0, nd = 0;
+  split_polygon(tri, 3, true, x0, drop, nd, a, na);
+  if (na < 3) return 0;
+  split_polygon(a, na, true, x1, b, nb, drop, nd);
+  if (nb < 3) return 0;
+  split_polygon(b, nb, false, y0, drop, nd, a, na);
+  if (na < 3) return 0;
+  split_polygon(a, na, false, y1, b, nb, drop, nd);
+  if (nb < 3) return 0;
+  for (int k = 0; k < nb; ++k) out[k] = b[k];
+  return nb;
 }
 
 PolygonMoments polygon_moments(const Vec2* p, int n) {
