@@ -160,52 +160,49 @@ void ImmersedSolid::clip_body(const FaceBoxes& boxes, int b, const std::vector<d
   }
 }
 
-// Sort the pieces by face (a counting sort over the touched faces only).
+// The touched faces (sorted) and each entry's slot among them; the area of each face.
 void ImmersedSolid::gather(const Raw& fixed, const Raw& moving, Pieces& p, Scratch& s) {
-  auto& m_slot = s.slot;
-  auto& m_count = s.count;
+  auto& slot = s.slot;
+  p.fixed = &fixed;
+  p.moving = &moving;
   p.face.clear();
   for (const Raw* r : {&fixed, &moving})
     for (const std::int32_t f : r->face)
-      if (m_slot[f] < 0) m_slot[f] = 0, p.face.push_back(f);
+      if (slot[f] < 0) slot[f] = 0, p.face.push_back(f);
   std::sort(p.face.begin(), p.face.end());
   const std::size_t nf = p.face.size();
-  for (std::size_t k = 0; k < nf; ++k) m_slot[p.face[k]] = static_cast<std::int32_t>(k);
-  p.begin.assign(nf + 1, 0);
-  for (const Raw* r : {&fixed, &moving})
-    for (const std::int32_t f : r->face) ++p.begin[m_slot[f] + 1];
-  for (std::size_t k = 0; k < nf; ++k) p.begin[k + 1] += p.begin[k];
-  const std::size_t ne = static_cast<std::size_t>(p.begin[nf]);
-  p.body.resize(ne), p.node.resize(ne), p.weight.resize(ne);
-  m_count.assign(p.begin.begin(), p.begin.end() - 1);
-  for (const Raw* r : {&fixed, &moving}) {
-    for (std::size_t e = 0; e < r->face.size(); ++e) {
-      const std::int32_t at = m_count[m_slot[r->face[e]]]++;
-      p.body[at] = r->body[e], p.node[at] = r->node[e], p.weight[at] = r->weight[e];
-    }
-  }
+  for (std::size_t k = 0; k < nf; ++k) slot[p.face[k]] = static_cast<std::int32_t>(k);
   p.area.assign(nf, 0.0);
+  auto slots = [&](const Raw& r, std::vector<std::int32_t>& out) {
+    out.resize(r.face.size());
+    for (std::size_t e = 0; e < r.face.size(); ++e) {
+      out[e] = slot[r.face[e]];
+      p.area[out[e]] += r.weight[e];
+    }
+  };
+  slots(fixed, p.slot_fixed);
+  slots(moving, p.slot_moving);
   p.total_area = 0;
   for (std::size_t k = 0; k < nf; ++k) {
-    for (std::int32_t e = p.begin[k]; e < p.begin[k + 1]; ++e) p.area[k] += p.weight[e];
     p.total_area += p.area[k];
-    m_slot[p.face[k]] = -1;
+    slot[p.face[k]] = -1;
   }
 }
 
 void ImmersedSolid::fill(const FaceBoxes& boxes, const Pieces& p, const proto::SolidState& state,
                          int component, proto::FaceSolid& out) const {
   const std::size_t nf = p.face.size();
+  p.sum.assign(nf, 0.0);
+  for (const auto& [r, slot] : {std::pair{p.fixed, &p.slot_fixed}, std::pair{p.moving, &p.slot_moving}})
+    for (std::size_t e = 0; e < r->face.size(); ++e)
+      p.sum[(*slot)[e]] += r->weight[e] * state.v[r->body[e]][2 * r->node[e] + component];
   out.index = p.face;
   out.alpha.resize(nf);
   out.velocity.resize(nf);
   for (std::size_t k = 0; k < nf; ++k) {
     const int i = p.face[k] % boxes.ni, j = p.face[k] / boxes.ni;
     out.alpha[k] = std::min(1.0, p.area[k] / boxes.volume(i, j));
-    double sum = 0;
-    for (std::int32_t e = p.begin[k]; e < p.begin[k + 1]; ++e)
-      sum += p.weight[e] * state.v[p.body[e]][2 * p.node[e] + component];
-    out.velocity[k] = sum / p.area[k];
+    out.velocity[k] = p.sum[k] / p.area[k];
   }
 }
 
@@ -246,12 +243,16 @@ void ImmersedSolid::reaction(const std::vector<double>& fs_u, const std::vector<
   auto add = [&](const FaceBoxes& boxes, const Pieces& p, const std::vector<double>& fs, int c) {
     if (fs.size() != p.face.size())
       fsi::fail("protocol error: {} forcing values for {} solid faces", fs.size(), p.face.size());
+    // Per face, −f_s |V| / Σ|V ∩ T|; then each entry's share of it.
+    p.sum.resize(p.face.size());
     for (std::size_t k = 0; k < p.face.size(); ++k) {
       const int i = p.face[k] % boxes.ni, j = p.face[k] / boxes.ni;
-      const double coef = -fs[k] * boxes.volume(i, j) / p.area[k];
-      for (std::int32_t e = p.begin[k]; e < p.begin[k + 1]; ++e)
-        force[p.body[e]][2 * p.node[e] + c] += coef * p.weight[e];
+      p.sum[k] = -fs[k] * boxes.volume(i, j) / p.area[k];
     }
+    for (const auto& [r, slot] :
+         {std::pair{p.fixed, &p.slot_fixed}, std::pair{p.moving, &p.slot_moving}})
+      for (std::size_t e = 0; e < r->face.size(); ++e)
+        force[r->body[e]][2 * r->node[e] + c] += p.sum[(*slot)[e]] * r->weight[e];
   };
   add(m_ub, m_u, fs_u, 0);
   add(m_vb, m_v, fs_v, 1);

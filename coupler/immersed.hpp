@@ -52,24 +52,26 @@ class ImmersedSolid {
   double area_v() const { return m_v.total_area; }
 
  private:
-  // The clipped pieces of one family: per touched face (sorted by index), its entries
-  // (body, node, ∫N dA) in [begin[k], begin[k+1]).
-  struct Pieces {
-    std::vector<std::int32_t> face;
-    std::vector<double> area;            // Σ |V ∩ T| of the face
-    std::vector<std::int32_t> begin;
-    std::vector<std::int32_t> body, node;
-    std::vector<double> weight;
-    double total_area = 0;
-  };
-  struct Raw {  // unsorted entries while clipping
+  struct Raw {  // entries (face, body, node, ∫_{V∩T} N_node dA) in clipping order
     std::vector<std::int32_t> face, body, node;
     std::vector<double> weight;
     void clear() { face.clear(), body.clear(), node.clear(), weight.clear(); }
   };
+  // The touched faces of one family (sorted by index) and, for the entries of the fixed and the
+  // moving bodies' Raw lists, the slot of each entry's face: per-face sums are then one pass over
+  // the entries into slot-indexed arrays, with no reordering of the entries.
+  struct Pieces {
+    std::vector<std::int32_t> face;
+    std::vector<double> area;            // Σ |V ∩ T| of the face
+    std::vector<std::int32_t> slot_fixed, slot_moving;
+    const Raw* fixed = nullptr;
+    const Raw* moving = nullptr;
+    double total_area = 0;
+    mutable std::vector<double> sum;     // scratch: per-face sums in fill() and reaction()
+  };
   void clip_body(const FaceBoxes& boxes, int b, const std::vector<double>& x, Raw& raw) const;
-  struct Scratch {  // per face of a family: -1, or its slot while gather() runs; counters
-    std::vector<std::int32_t> slot, count;
+  struct Scratch {  // per face of a family: -1, or its slot while gather() runs
+    std::vector<std::int32_t> slot;
   };
   void gather(const Raw& fixed, const Raw& moving, Pieces& p, Scratch& s);
   void fill(const FaceBoxes& boxes, const Pieces& p, const proto::SolidState& state, int component,
