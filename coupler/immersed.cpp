@@ -61,8 +61,45 @@ FaceBoxes FaceBoxes::v_faces(const proto::GridInfo& g) {
   return b;
 }
 
+EdgeIndex::EdgeIndex(const std::vector<double>& e) : m_e(&e) {
+  const std::size_t n = e.size() - 1;
+  const double h = (e[n] - e[0]) / static_cast<double>(n);
+  m_even = n > 0 && h > 0;
+  for (std::size_t k = 1; k <= n && m_even; ++k)
+    m_even = std::abs(e[k] - e[k - 1] - h) <= 1e-9 * h;
+  if (m_even) m_inv = 1.0 / h;
+}
+
+int EdgeIndex::last_at_or_below(double c) const {
+  const std::vector<double>& e = *m_e;
+  const int n = static_cast<int>(e.size()) - 1;
+  if (!m_even) return static_cast<int>(std::upper_bound(e.begin(), e.end(), c) - e.begin()) - 1;
+  const double g = std::floor((c - e[0]) * m_inv);
+  int k = g < -1 ? -1 : (g > n ? n : static_cast<int>(g));
+  while (k >= 0 && e[k] > c) --k;
+  while (k < n && e[k + 1] <= c) ++k;
+  return k;
+}
+
+int EdgeIndex::last_below(double c) const {
+  const std::vector<double>& e = *m_e;
+  const int n = static_cast<int>(e.size()) - 1;
+  if (!m_even) return static_cast<int>(std::lower_bound(e.begin(), e.end(), c) - e.begin()) - 1;
+  const double g = std::floor((c - e[0]) * m_inv);
+  int k = g < -1 ? -1 : (g > n ? n : static_cast<int>(g));
+  while (k >= 0 && e[k] >= c) --k;
+  while (k < n && e[k + 1] < c) ++k;
+  return k;
+}
+
 ImmersedSolid::ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshes& meshes)
-    : m_meshes(meshes), m_ub(FaceBoxes::u_faces(grid)), m_vb(FaceBoxes::v_faces(grid)) {
+    : m_meshes(meshes),
+      m_ub(FaceBoxes::u_faces(grid)),
+      m_vb(FaceBoxes::v_faces(grid)),
+      m_ux(m_ub.ex),
+      m_uy(m_ub.ey),
+      m_vx(m_vb.ex),
+      m_vy(m_vb.ey) {
   m_scratch_u.slot.assign(static_cast<std::size_t>(m_ub.ni * m_ub.nj), -1);
   m_scratch_v.slot.assign(static_cast<std::size_t>(m_vb.ni * m_vb.nj), -1);
   m_threads = std::thread::hardware_concurrency() > 1;
@@ -70,8 +107,8 @@ ImmersedSolid::ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshe
 
 // Every triangle of body b at positions x, against every box its bounding box meets (and its
 // periodic images).
-void ImmersedSolid::clip_body(const FaceBoxes& boxes, int b, const std::vector<double>& x,
-                              Raw& raw) const {
+void ImmersedSolid::clip_body(const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy,
+                              int b, const std::vector<double>& x, Raw& raw) const {
   const auto& tri = m_meshes.bodies[b].tri;
   const double sx[3] = {0.0, -boxes.period_x, boxes.period_x};
   const double sy[3] = {0.0, -boxes.period_y, boxes.period_y};
@@ -100,14 +137,10 @@ void ImmersedSolid::clip_body(const FaceBoxes& boxes, int b, const std::vector<d
         const double x0 = bx0 + sx[qx], x1 = bx1 + sx[qx], y0 = by0 + sy[qy], y1 = by1 + sy[qy];
         if (x1 <= xlo || x0 >= xhi || y1 <= ylo || y0 >= yhi) continue;
         for (int k = 0; k < 3; ++k) t[k] = {p[k].x + sx[qx], p[k].y + sy[qy]};
-        const int i0 = std::max<int>(
-            boxes.i_lo, std::upper_bound(boxes.ex.begin(), boxes.ex.end(), x0) - boxes.ex.begin() - 1);
-        const int i1 = std::min<int>(
-            boxes.i_hi - 1, std::lower_bound(boxes.ex.begin(), boxes.ex.end(), x1) - boxes.ex.begin() - 1);
-        const int j0 = std::max<int>(
-            boxes.j_lo, std::upper_bound(boxes.ey.begin(), boxes.ey.end(), y0) - boxes.ey.begin() - 1);
-        const int j1 = std::min<int>(
-            boxes.j_hi - 1, std::lower_bound(boxes.ey.begin(), boxes.ey.end(), y1) - boxes.ey.begin() - 1);
+        const int i0 = std::max(boxes.i_lo, ix.last_at_or_below(x0));
+        const int i1 = std::min(boxes.i_hi - 1, ix.last_below(x1));
+        const int j0 = std::max(boxes.j_lo, iy.last_at_or_below(y0));
+        const int j1 = std::min(boxes.j_hi - 1, iy.last_below(y1));
         if (i0 > i1 || j0 > j1) continue;
         auto emit = [&](const Vec2* poly, int n, int i, int j) {
           if (n < 3) return;
@@ -130,29 +163,48 @@ void ImmersedSolid::clip_body(const FaceBoxes& boxes, int b, const std::vector<d
           continue;
         }
         // Columns: cut the triangle at the box edges ex[i0] .. ex[i1 + 1], then each column at
-        // ey[j0] .. ey[j1 + 1] (split_polygon); parts outside [i0, i1] × [j0, j1] are dropped.
+        // ey[j0] .. ey[j1 + 1] (split_polygon); parts outside [i0, i1] × [j0, j1] are dropped. A
+        // line the polygon does not cross is not cut: the first and last edges lie outside the
+        // triangle's extent unless the range was clamped to the unknown faces.
         Vec2 s1[kMaxSplit], s2[kMaxSplit], col[kMaxSplit], c1[kMaxSplit], c2[kMaxSplit];
         Vec2 piece[kMaxSplit], drop[kMaxSplit];
         int nr = 3, nd = 0;
         Vec2* rem = s1;
         Vec2* spare = s2;
         for (int k = 0; k < 3; ++k) rem[k] = t[k];
-        split_polygon(rem, nr, true, boxes.ex[i0], drop, nd, spare, nr);
-        std::swap(rem, spare);
+        if (boxes.ex[i0] > x0) {
+          split_polygon(rem, nr, true, boxes.ex[i0], drop, nd, spare, nr);
+          std::swap(rem, spare);
+        }
         for (int i = i0; i <= i1 && nr >= 3; ++i) {
           int nc = 0;
-          split_polygon(rem, nr, true, boxes.ex[i + 1], col, nc, spare, nr);
-          std::swap(rem, spare);
+          const Vec2* column = rem;
+          if (i < i1 || boxes.ex[i1 + 1] < x1) {
+            split_polygon(rem, nr, true, boxes.ex[i + 1], col, nc, spare, nr);
+            std::swap(rem, spare);
+            column = col;
+          } else {
+            nc = nr, nr = 0;
+          }
           if (nc < 3) continue;
           Vec2* crem = c1;
           Vec2* cspare = c2;
-          int ncr = 0;
-          split_polygon(col, nc, false, boxes.ey[j0], drop, nd, crem, ncr);
+          int ncr = nc;
+          if (boxes.ey[j0] > y0) {
+            split_polygon(column, nc, false, boxes.ey[j0], drop, nd, crem, ncr);
+          } else {
+            for (int k = 0; k < nc; ++k) crem[k] = column[k];
+          }
           for (int j = j0; j <= j1 && ncr >= 3; ++j) {
-            int np = 0;
-            split_polygon(crem, ncr, false, boxes.ey[j + 1], piece, np, cspare, ncr);
-            std::swap(crem, cspare);
-            emit(piece, np, i, j);
+            if (j < j1 || boxes.ey[j1 + 1] < y1) {
+              int np = 0;
+              split_polygon(crem, ncr, false, boxes.ey[j + 1], piece, np, cspare, ncr);
+              std::swap(crem, cspare);
+              emit(piece, np, i, j);
+            } else {
+              emit(crem, ncr, i, j);
+              ncr = 0;
+            }
           }
         }
       }
@@ -213,24 +265,24 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
   // The two families are independent (own boxes, pieces and scratch): the v-family runs on a
   // second thread while this one does the u-family. The other programs wait for this step's
   // messages meanwhile, so the second core is free.
-  auto family = [&](const FaceBoxes& boxes, Raw& fixed, Raw& raw, Pieces& p, Scratch& s, int c,
+  auto family = [&](const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy, Raw& fixed, Raw& raw, Pieces& p, Scratch& s, int c,
                     proto::FaceSolid& out) {
     if (!m_fixed_done)
       for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
-        if (bodies[b].kind == 1) clip_body(boxes, b, state.x[b], fixed);
+        if (bodies[b].kind == 1) clip_body(boxes, ix, iy, b, state.x[b], fixed);
     raw.clear();
     for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
-      if (bodies[b].kind != 1) clip_body(boxes, b, state.x[b], raw);
+      if (bodies[b].kind != 1) clip_body(boxes, ix, iy, b, state.x[b], raw);
     gather(fixed, raw, p, s);
     fill(boxes, p, state, c, out);
   };
   if (m_threads) {
-    std::thread second([&] { family(m_vb, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v); });
-    family(m_ub, m_fixed_u, m_raw_u, m_u, m_scratch_u, 0, u);
+    std::thread second([&] { family(m_vb, m_vx, m_vy, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v); });
+    family(m_ub, m_ux, m_uy, m_fixed_u, m_raw_u, m_u, m_scratch_u, 0, u);
     second.join();
   } else {
-    family(m_ub, m_fixed_u, m_raw_u, m_u, m_scratch_u, 0, u);
-    family(m_vb, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v);
+    family(m_ub, m_ux, m_uy, m_fixed_u, m_raw_u, m_u, m_scratch_u, 0, u);
+    family(m_vb, m_vx, m_vy, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v);
   }
   m_fixed_done = true;
 }

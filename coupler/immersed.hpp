@@ -29,6 +29,22 @@ struct FaceBoxes {
   double volume(int i, int j) const { return (ex[i + 1] - ex[i]) * (ey[j + 1] - ey[j]); }
 };
 
+// Where a coordinate falls among sorted box edges e[0..n]: last_at_or_below(c) is the largest k
+// with e[k] <= c, last_below(c) the largest k with e[k] < c (−1 when there is none). On evenly
+// spaced edges the index comes from one division, checked against the edges themselves (so
+// round-off never misplaces it); uneven edges take a binary search.
+class EdgeIndex {
+ public:
+  explicit EdgeIndex(const std::vector<double>& e);
+  int last_at_or_below(double c) const;
+  int last_below(double c) const;
+
+ private:
+  const std::vector<double>* m_e = nullptr;
+  bool m_even = false;
+  double m_inv = 0;
+};
+
 class ImmersedSolid {
  public:
   ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshes& meshes);
@@ -46,6 +62,9 @@ class ImmersedSolid {
   // so Σ_a F_a = − Σ_V f_s(V) |V| to round-off. `force` gets one vector (2 per node) per body.
   void reaction(const std::vector<double>& fs_u, const std::vector<double>& fs_v,
                 std::vector<std::vector<double>>& force) const;
+
+  // The u- and v-families on two threads (default: when the machine has more than one core).
+  void set_threads(bool on) { m_threads = on; }
 
   // The solid area seen by each family in the last update (Σ_V α|V| without the cap), for checks.
   double area_u() const { return m_u.total_area; }
@@ -69,7 +88,8 @@ class ImmersedSolid {
     double total_area = 0;
     mutable std::vector<double> sum;     // scratch: per-face sums in fill() and reaction()
   };
-  void clip_body(const FaceBoxes& boxes, int b, const std::vector<double>& x, Raw& raw) const;
+  void clip_body(const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy, int b,
+                 const std::vector<double>& x, Raw& raw) const;
   struct Scratch {  // per face of a family: -1, or its slot while gather() runs
     std::vector<std::int32_t> slot;
   };
@@ -79,6 +99,7 @@ class ImmersedSolid {
 
   const proto::BodyMeshes& m_meshes;
   FaceBoxes m_ub, m_vb;
+  EdgeIndex m_ux, m_uy, m_vx, m_vy;  // box lookup of each family
   Raw m_fixed_u, m_fixed_v, m_raw_u, m_raw_v;  // rigid fixed bodies' pieces, clipped once
   bool m_fixed_done = false;
   Pieces m_u, m_v;
