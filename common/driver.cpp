@@ -56,26 +56,42 @@ void run_alone(Runtime& rt, Port& port, Advance advance) {
   progress.finish(s.steps, step_time(s, s.steps), fmt::format("output in {}", rt.out_dir().string()));
 }
 
-// Coupled: follow the coupler's step_begin messages until it says stop.
+// Coupled: follow the coupler's step_begin messages until it says stop. A step is committed,
+// and its output written, when the next step begins with iteration 0 or the run stops: an
+// iteration k > 0 repeats the step just done (PROTOCOL.md, "Coupled iterations").
 template <class Port, class Advance>
 void follow(Runtime& rt, Port& port, Advance advance) {
   Link& c = rt.coupler_link();
   c.send(proto::Text{proto::Tag::effective_scene, rt.scene().effective_toml()});
   const auto& s = rt.settings();
   port.output(0, 0.0, is_output_step(s, 0));
-  long steps = 0;
+  long steps = 0, repeats = 0;
+  bool pending = false;  // step `steps` - 1 is done but not yet committed
+  double t_done = 0;
   for (;;) {
     proto::StepBegin sb;
     c.recv(sb);
+    const bool commit = sb.action == proto::Action::stop || sb.iteration == 0;
+    if (pending && commit) {
+      port.output(steps, t_done, is_output_step(s, steps));
+      pending = false;
+    }
     if (sb.action == proto::Action::stop) break;
-    rt.check_fault(sb.step);
+    const long expected = sb.iteration == 0 ? steps : steps - 1;
+    if (sb.step != expected || sb.iteration < 0 || (sb.iteration > 0 && !pending))
+      fail("protocol error: the coupler began step {} iteration {} after step {} was done",
+           sb.step, sb.iteration, steps - 1);
+    if (sb.iteration == 0) rt.check_fault(sb.step);
+    else ++repeats;
     advance(sb);
     steps = sb.step + 1;
-    port.output(steps, sb.time + sb.dt, is_output_step(s, steps));
+    t_done = sb.time + sb.dt;
+    pending = true;
   }
   nlohmann::json j = port.report();
   j["wall_time"] = rt.wall_seconds();
   j["steps"] = steps;
+  if (repeats > 0) j["repeated_steps"] = repeats;
   j["bytes_sent"] = c.bytes_sent();
   j["bytes_received"] = c.bytes_received();
   c.send(proto::Text{proto::Tag::final_report, j.dump()});
@@ -84,9 +100,12 @@ void follow(Runtime& rt, Port& port, Advance advance) {
 // The per-step exchange of a solver that reports its state (solid, fiber): its input from the
 // coupler, the step, its new state back.
 template <class Port, class In, class State>
-void follow_state(Runtime& rt, Port& port, In& in, State& st) {
+void follow_state(Runtime& rt, Port& port, In& in, State& st, bool can_iterate) {
   Link& c = rt.coupler_link();
   follow(rt, port, [&](const proto::StepBegin& sb) {
+    if (sb.iteration > 0 && !can_iterate)
+      fail("protocol error: the coupler asked the {} to repeat step {}, which it cannot",
+           rt.name(), sb.step);
     c.recv(in);
     port.advance(sb, in);
     port.state(st);
@@ -102,8 +121,12 @@ void serve(Runtime& rt, FluidPort& port) {
   if (!rt.coupled()) return run_alone(rt, port, [&](const proto::StepBegin& sb) {
     port.advance(sb, in, out);
   });
-  rt.coupler_link().send(port.grid_info());
+  proto::GridInfo grid = port.grid_info();
+  grid.can_iterate = port.can_iterate();
+  rt.coupler_link().send(grid);
   follow(rt, port, [&](const proto::StepBegin& sb) {
+    if (sb.iteration > 0 && !port.can_iterate())
+      fail("protocol error: the coupler asked the fluid to repeat step {}, which it cannot", sb.step);
     rt.coupler_link().recv(in);
     port.advance(sb, in, out);
     rt.coupler_link().send(out, sb.step);
@@ -117,10 +140,12 @@ void serve(Runtime& rt, SolidPort& port) {
     port.advance(sb, in);
   });
   Link& c = rt.coupler_link();
-  c.send(port.meshes());
+  proto::BodyMeshes meshes = port.meshes();
+  meshes.can_iterate = port.can_iterate();
+  c.send(meshes);
   port.state(st);
   c.send(st);
-  follow_state(rt, port, in, st);
+  follow_state(rt, port, in, st, port.can_iterate());
 }
 
 void serve(Runtime& rt, FiberPort& port) {
@@ -135,7 +160,7 @@ void serve(Runtime& rt, FiberPort& port) {
   port.set_initial_roots(in.root_pose);
   port.state(st);
   c.send(st);
-  follow_state(rt, port, in, st);
+  follow_state(rt, port, in, st, false);
 }
 
 }  // namespace fsi

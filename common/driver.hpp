@@ -25,21 +25,31 @@ class SolverPort {
   virtual nlohmann::json report() const { return nlohmann::json::object(); }
 };
 
+// Coupled iterations (common/PROTOCOL.md, "Coupled iterations"): a fluid or solid port that
+// returns true from can_iterate() must accept advance() with s.iteration > 0, meaning "redo the
+// step s.step that the previous advance() did, from the state at its start, with this input".
+// Output is asked for only once a step is committed. A port that returns false (the default)
+// is never asked to repeat a step: the coupler refuses a scene with iterations for it.
 class FluidPort : public SolverPort {
  public:
   virtual proto::GridInfo grid_info() const = 0;
   // One fluid step t^n -> t^n + dt with the coupler's sparse input; fills `out` (f_s on the
-  // solid faces, samples of u^(n+1), diagnostics).
+  // solid faces, samples of u^(n+1), diagnostics). With s.iteration > 0: the same step again
+  // from the same predictor u~ (and p^n), with new solid velocities: redo the immersed forcing
+  // and the projection only (the fibers' force is the same as in iteration 0).
   virtual void advance(const proto::StepBegin& s, const proto::FluidInput& in,
                        proto::FluidOutput& out) = 0;
+  virtual bool can_iterate() const { return false; }
 };
 
 class SolidPort : public SolverPort {
  public:
   virtual proto::BodyMeshes meshes() const = 0;
   virtual void state(proto::SolidState& s) const = 0;  // current x, v of every body
-  // One solid step with nodal forces on the solid (empty vectors: no coupling force).
+  // One solid step with nodal forces on the solid (empty vectors: no coupling force). With
+  // s.iteration > 0: the same step again from the state saved at its start (iteration 0).
   virtual void advance(const proto::StepBegin& s, const proto::SolidInput& in) = 0;
+  virtual bool can_iterate() const { return false; }
 };
 
 class FiberPort : public SolverPort {

@@ -65,16 +65,17 @@ void get(Reader& r, FaceForce& f) {
 
 void GridInfo::pack(Writer& w) const {
   w.put(nx), w.put(ny), w.put(periodic_x), w.put(periodic_y), w.put(x_face), w.put(y_face);
-  w.put(density);
+  w.put(density), w.put(can_iterate);
 }
 void GridInfo::unpack(Reader& r) {
   r.get(nx), r.get(ny), r.get(periodic_x), r.get(periodic_y), r.get(x_face), r.get(y_face);
-  r.get(density);
+  r.get(density), r.get(can_iterate);
 }
 
 void BodyMeshes::pack(Writer& w) const {
   w.put(static_cast<std::int64_t>(bodies.size()));
   for (const auto& b : bodies) w.put(b.name), w.put(b.kind), w.put(b.x_ref), w.put(b.tri), w.put(b.edges);
+  w.put(can_iterate);
 }
 void BodyMeshes::unpack(Reader& r) {
   std::int64_t n = 0;
@@ -82,6 +83,7 @@ void BodyMeshes::unpack(Reader& r) {
   if (n < 0 || n > (1 << 20)) fail("protocol error: body count {} out of range", n);
   bodies.resize(static_cast<std::size_t>(n));
   for (auto& b : bodies) r.get(b.name), r.get(b.kind), r.get(b.x_ref), r.get(b.tri), r.get(b.edges);
+  r.get(can_iterate);
 }
 
 void FiberLayout::pack(Writer& w) const {
@@ -103,8 +105,12 @@ void FiberLayout::unpack(Reader& r) {
 void Text::pack(Writer& w) const { w.put(text); }
 void Text::unpack(Reader& r) { r.get(text); }
 
-void StepBegin::pack(Writer& w) const { w.put(step), w.put(time), w.put(dt), w.put(action); }
-void StepBegin::unpack(Reader& r) { r.get(step), r.get(time), r.get(dt), r.get(action); }
+void StepBegin::pack(Writer& w) const {
+  w.put(step), w.put(time), w.put(dt), w.put(action), w.put(iteration);
+}
+void StepBegin::unpack(Reader& r) {
+  r.get(step), r.get(time), r.get(dt), r.get(action), r.get(iteration);
+}
 
 void FluidInput::pack(Writer& w) const {
   put(w, solid_u), put(w, solid_v), put(w, force_u), put(w, force_v);

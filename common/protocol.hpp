@@ -17,7 +17,7 @@
 namespace fsi::proto {
 
 // Bump on any change of a message's layout or of the message order.
-inline constexpr std::int32_t kVersion = 1;
+inline constexpr std::int32_t kVersion = 2;
 inline constexpr std::uint32_t kMagic = 0x4d495346;  // "FSIM"
 
 enum class Tag : std::int32_t {
@@ -113,6 +113,7 @@ struct GridInfo {  // fluid -> coupler, once
   std::vector<double> x_face;  // nx + 1 face coordinates (cell i spans x_face[i]..x_face[i+1])
   std::vector<double> y_face;  // ny + 1
   double density = 0;          // rho_f
+  std::int32_t can_iterate = 0;  // 1: the fluid can repeat a step (StepBegin::iteration > 0)
   void pack(Writer& w) const;
   void unpack(Reader& r);
 };
@@ -128,6 +129,7 @@ struct BodyMesh {
 struct BodyMeshes {  // solid -> coupler, once
   static constexpr Tag tag = Tag::body_meshes;
   std::vector<BodyMesh> bodies;
+  std::int32_t can_iterate = 0;  // 1: the solid can repeat a step (StepBegin::iteration > 0)
   void pack(Writer& w) const;
   void unpack(Reader& r);
 };
@@ -166,6 +168,10 @@ struct StepBegin {  // coupler -> each solver, every step
   double time = 0;        // t^n
   double dt = 0;
   Action action = Action::step;
+  // Coupled iterations: 0 for the first pass of step n; k > 0 asks the fluid and the solid to
+  // redo the same step from its start with new input (sub-iteration k). A step is committed
+  // (the solver may write its output) when step n + 1 begins with iteration 0, or at stop.
+  std::int32_t iteration = 0;
   void pack(Writer& w) const;
   void unpack(Reader& r);
 };

@@ -9,6 +9,11 @@
 #include <sstream>
 #include <toml.hpp>
 
+// Eigen is header-only; the coupler library does not link its CMake target, so the header is
+// named through its install folder.
+#include <eigen3/Eigen/Core>
+#include <eigen3/Eigen/QR>
+
 #include "driver.hpp"
 
 namespace coupler {
@@ -41,8 +46,39 @@ Coupler::Coupler(fsi::Runtime& rt) : m_rt(rt) {
       m_growth_steps = h->positive_integer("growth_steps", m_growth_steps);
       h->finish();
     }
+    if (const auto it = c->optional_table("iterations")) read_iterations(*it);
     c->finish();
   }
+  if (m_iter.max > 1) m_accel = std::make_unique<Acceleration>(m_iter);
+}
+
+void Coupler::read_iterations(const fsi::SceneTable& t) {
+  m_iter.max = static_cast<int>(t.positive_integer("max", 1));
+  if (m_iter.max > 1000) t.fail("max", fmt::format("must be <= 1000, got {}", m_iter.max));
+  m_iter.tolerance = t.in_range("tolerance", 0.0, 1.0, true, 1e-6);
+  const std::string a = t.choice("acceleration", {"iqn-ils", "aitken", "constant"}, "iqn-ils");
+  m_iter.method = a == "aitken"     ? IterationSettings::Method::aitken
+                  : a == "constant" ? IterationSettings::Method::constant
+                                    : IterationSettings::Method::iqn_ils;
+  m_iter.relaxation = t.in_range("relaxation", 0.0, 1.0, false, 0.5);
+  if (!(m_iter.relaxation > 0)) t.fail("relaxation", "must be in (0, 1], got 0");
+  const long reuse = t.integer("reuse", 0);
+  if (reuse < 0 || reuse > 100) t.fail("reuse", fmt::format("must be in [0, 100], got {}", reuse));
+  m_iter.reuse = static_cast<int>(reuse);
+  t.finish();
+}
+
+// Sub-iterations need a fluid and a solid that can repeat a step (their ports say so at set-up).
+void Coupler::check_can_iterate() const {
+  if (m_iter.max <= 1) return;
+  auto refuse = [&](const char* program) {
+    throw fsi::InputError(fmt::format(
+        "coupler.iterations.max = {} asks every step to be repeated, but the {} program cannot "
+        "repeat a step (its port does not implement coupled iterations); set max = 1 (in {})",
+        m_iter.max, program, m_rt.scene().file().string()));
+  };
+  if (has(Role::fluid) && !m_grid.can_iterate) refuse("fluid");
+  if (has(Role::solid) && !m_meshes.can_iterate) refuse("solid");
 }
 
 void Coupler::run() {
@@ -100,7 +136,7 @@ void Coupler::setup() {
     l.recv(m_layout);
     m_fiber_in.force.assign(m_layout.fibers.size(), {});
     resolve_roots();
-    root_poses(m_fiber_in.root_pose);
+    root_poses(m_solid, m_fiber_in.root_pose);
     l.send(m_fiber_in);
     l.recv(m_fiber);
     effective(l, "fiber");
@@ -128,6 +164,7 @@ void Coupler::setup() {
                    m_kappa, m_kappa_gain, dt);
     }
   }
+  check_can_iterate();
   const auto& bodies = m_meshes.bodies;
   if (!bodies.empty()) {
     if (!has(Role::fluid))
@@ -165,6 +202,11 @@ void Coupler::setup() {
     m_probes = std::make_unique<fsi::ProbeCsv>(m_rt.out_dir() / "coupler_forces.csv", cols);
     m_probe_row.assign(cols.size(), 0.0);
   }
+  if (m_accel)
+    m_iter_csv = std::make_unique<fsi::ProbeCsv>(
+        m_rt.out_dir() / "coupler_iterations.csv",
+        std::vector<std::string>{"step", "iterations", "residual_first", "residual", "converged",
+                                 "omega", "columns"});
   if (m_log_csv || m_dump_every > 0)
     m_log = std::make_unique<ExchangeLog>(m_rt.out_dir(), m_grid, m_meshes, m_layout,
                                           m_rt.settings().dt, m_log_csv, m_dump_every);
@@ -319,70 +361,179 @@ void Coupler::exchange(Role r, const In& in, Out& out, long n) {
   m_phases.stop(fsi::role_name(r));
 }
 
-// One step t^n -> t^(n+1), DESIGN.md §3.
+// One step t^n -> t^(n+1), DESIGN.md §3, with coupled iterations when
+// coupler.iterations.max > 1 (README.md): steps 3-7 are repeated, the fluid redoing its forcing
+// and projection from the same predictor u~ and the solid its step from the state at t^n,
+// until the solid's velocities stop changing; then the step is committed and the fibers follow.
+// With max = 1 this is the explicit staggered step, every operation in the same order.
 void Coupler::step(long n) {
   const auto& s = m_rt.settings();
-  const proto::StepBegin sb{n, fsi::step_time(s, n), s.dt, proto::Action::step};
+  proto::StepBegin sb{n, fsi::step_time(s, n), s.dt, proto::Action::step, 0};
   for (Role r : {Role::fluid, Role::solid, Role::fiber})
     if (has(r)) m_rt.link(r).send(sb, n);
   m_rt.check_fault(n);
+  m_start = m_solid;  // the bodies' state at t^n
 
-  // 2: the bodies' footprint, α and ū_s from the solid state at t^n.
-  if (m_immersed) {
-    m_phases.start("footprint");
-    m_immersed->update(m_solid, m_fluid_in.solid_u, m_fluid_in.solid_v);
-    m_phases.stop("footprint");
+  // The footprint's state: x^n, and the first estimate of the velocities at t^(n+1). The
+  // explicit step takes v^n. Iterations start from the linear extrapolation 2 v^n - v^(n-1)
+  // (v^n on the first step): an O(dt^2) guess instead of O(dt) for smooth motion, so fewer
+  // iterations; the converged step does not depend on it.
+  const bool iterate = m_accel && m_immersed;
+  const proto::SolidState* footprint = &m_start;
+  if (iterate) {
+    m_guess = m_start;
+    if (m_v_before.size() == m_start.v.size())
+      for (std::size_t b = 0; b < m_guess.v.size(); ++b)
+        if (m_meshes.bodies[b].kind == 0 && m_v_before[b].size() == m_guess.v[b].size())
+          for (std::size_t d = 0; d < m_guess.v[b].size(); ++d)
+            m_guess.v[b][d] = 2 * m_start.v[b][d] - m_v_before[b][d];
+    m_v_before = m_start.v;
+    footprint = &m_guess;
+    m_accel->begin_step();
   }
-  // 2: the fibers' feedback force from U(X^n), its spread, and the faces to sample next.
+  // 2: the fibers' feedback force from U(X^n), its spread, and the faces to sample next
+  // (once per step: the fibers' step follows the converged solid).
   if (m_ib) {
     m_phases.start("fibers");
     feedback_forces();
     m_phases.stop("fibers");
   }
-  if (m_log)
-    m_log->inputs(n, sb.time, m_solid, m_fiber, m_fluid_in, m_fiber_in, m_ib.get(), m_have_samples);
-  // 3-4: the fluid step.
-  if (has(Role::fluid)) {
-    exchange(Role::fluid, m_fluid_in, m_fluid_out, n);
-    if (m_ib) {
-      m_ib->store_samples(m_fluid_in.sample_u, m_fluid_out.u_sample, m_fluid_in.sample_v,
-                          m_fluid_out.v_sample);
-      m_have_samples = true;
+  const bool had_samples = m_have_samples;
+
+  int k = 0;
+  bool converged = !iterate;
+  double res_first = 0, res = 0;
+  for (;; ++k) {
+    if (k > 0) {
+      sb.iteration = k;
+      for (Role r : {Role::fluid, Role::solid})
+        if (has(r)) m_rt.link(r).send(sb, n);
     }
+    // 2: the bodies' footprint, α and ū_s, from x^n and the velocity estimate.
+    if (m_immersed) {
+      m_phases.start("footprint");
+      m_immersed->update(*footprint, m_fluid_in.solid_u, m_fluid_in.solid_v);
+      m_phases.stop("footprint");
+    }
+    // 3-4: the fluid step (or its forcing and projection again).
+    if (has(Role::fluid)) exchange(Role::fluid, m_fluid_in, m_fluid_out, n);
+    // 5-6: the exact reaction of f_s on the bodies' nodes.
+    if (m_immersed) {
+      m_phases.start("reaction");
+      m_immersed->reaction(m_fluid_out.fs_u, m_fluid_out.fs_v, m_solid_in.force);
+      m_phases.stop("reaction");
+    }
+    m_reaction = m_solid_in.force;
+    // Rigid bodies move by their law: their reaction is only measured, not sent.
+    for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
+      if (m_meshes.bodies[b].kind != 0) m_solid_in.force[b].clear();
+    add_root_loads(m_start);
+    // 7: the solid step (or the same step again from its state at t^n).
+    if (has(Role::solid)) {
+      exchange(Role::solid, m_solid_in, m_solid, n);
+      if (m_immersed) check_bodies_in_domain(n + 1);
+    }
+    if (!iterate) break;
+    // Residual of the fixed point v = H(v) over every elastic body's nodes, against |v^(k+1)|
+    // with a floor at 1 % of the largest velocity of the run so far (a body passing through
+    // rest keeps an attainable target).
+    m_phases.start("iterations");
+    gather_velocities(*footprint, m_x_in);
+    gather_velocities(m_solid, m_x_out);
+    double r2 = 0, v2 = 0;
+    for (std::size_t i = 0; i < m_x_in.size(); ++i) {
+      const double d = m_x_out[i] - m_x_in[i];
+      r2 += d * d, v2 += m_x_out[i] * m_x_out[i];
+    }
+    const double scale = std::max(std::sqrt(v2), 0.01 * m_v_scale);
+    res = scale > 0 ? std::sqrt(r2) / scale : (r2 > 0 ? 1.0 : 0.0);
+    if (k == 0) res_first = res;
+    converged = res <= m_iter.tolerance;
+    if (converged || k + 1 >= m_iter.max) {
+      m_phases.stop("iterations");
+      break;
+    }
+    m_accel->update(m_x_in, m_x_out, m_x_next);
+    if (footprint != &m_guess) m_guess = m_start;
+    scatter_velocities(m_x_next, m_guess);
+    // Rigid bodies: their velocity at t^(n+1), as the solid just reported it.
+    for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
+      if (m_meshes.bodies[b].kind != 0) m_guess.v[b] = m_solid.v[b];
+    footprint = &m_guess;
+    m_phases.stop("iterations");
   }
-  // 5-6: the exact reaction of f_s on the bodies' nodes.
-  if (m_immersed) {
-    m_phases.start("reaction");
-    m_immersed->reaction(m_fluid_out.fs_u, m_fluid_out.fs_v, m_solid_in.force);
-    m_phases.stop("reaction");
+  if (iterate) {
+    const long its = k + 1;
+    m_accel->end_step();
+    m_iter_total += its;
+    m_iter_max = std::max(m_iter_max, its);
+    m_residual_max = std::max(m_residual_max, res);
+    double v2 = 0;
+    for (const auto& v : m_solid.v)
+      for (double x : v) v2 += x * x;
+    m_v_scale = std::max(m_v_scale, std::sqrt(v2));
+    if (!converged) {
+      ++m_not_converged;
+      if (m_not_converged <= 20)
+        std::fprintf(stderr,
+                     "[coupler] WARNING: step %ld (t = %.6g): the coupled iterations did not "
+                     "converge in coupler.iterations.max = %d: residual %.3e, tolerance %.1e%s\n",
+                     n, sb.time, m_iter.max, res, m_iter.tolerance,
+                     m_not_converged == 20 ? " (further warnings only counted in summary.json)"
+                                           : "");
+    }
+    m_iter_csv->write(fsi::step_time(s, n + 1),
+                      {double(n), double(its), res_first, res, converged ? 1.0 : 0.0,
+                       m_accel->omega(), double(m_accel->columns())});
   }
-  if (m_log) m_log->reaction(m_fluid_in, m_fluid_out, m_solid_in.force);
-  write_force_probes(n);
-  // Rigid bodies move by their law: their reaction is only measured, not sent.
-  for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
-    if (m_meshes.bodies[b].kind != 0) m_solid_in.force[b].clear();
+
+  // The committed step: the exchange log, the fibers' samples of u^(n+1), the force probes, the
+  // growth check, as for the explicit step.
   if (m_log) {
-    m_log->before_root_loads(m_solid_in.force);
-    root_poses(m_log_poses);
+    m_log->inputs(n, sb.time, *footprint, m_fiber, m_fluid_in, m_fiber_in, m_ib.get(), had_samples);
   }
-  add_root_loads();
-  if (m_log) m_log->root_loads(m_solid_in.force, m_fiber.root_load, m_log_poses);
-  // 7: the solid step.
-  if (has(Role::solid)) {
-    exchange(Role::solid, m_solid_in, m_solid, n);
-    if (m_immersed) check_bodies_in_domain(n + 1);
-    check_growth(n + 1);
+  if (m_ib && has(Role::fluid)) {
+    m_ib->store_samples(m_fluid_in.sample_u, m_fluid_out.u_sample, m_fluid_in.sample_v,
+                        m_fluid_out.v_sample);
+    m_have_samples = true;
   }
+  if (m_log) {
+    m_log->reaction(m_fluid_in, m_fluid_out, m_reaction);
+    auto before = m_reaction;
+    for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
+      if (m_meshes.bodies[b].kind != 0) before[b].clear();
+    m_log->before_root_loads(before);
+    root_poses(m_start, m_log_poses);
+    m_log->root_loads(m_solid_in.force, m_fiber.root_load, m_log_poses);
+  }
+  write_force_probes(n, m_start, m_reaction);
+  if (has(Role::solid)) check_growth(n + 1);
   // 8-9: the fiber step, with the root poses from the solid's new state.
   if (has(Role::fiber)) {
-    root_poses(m_fiber_in.root_pose);
+    root_poses(m_solid, m_fiber_in.root_pose);
     exchange(Role::fiber, m_fiber_in, m_fiber, n);
     if (m_ib) check_fibers_in_domain(n + 1);
   }
   if (m_log) m_log->end_step();
   m_progress->update(n + 1, fsi::step_time(s, n + 1), s.dt, [&] {
-    return fmt::format("CFL {:.3g}  div {:.1e}", m_fluid_out.cfl, m_fluid_out.max_div);
+    std::string st = fmt::format("CFL {:.3g}  div {:.1e}", m_fluid_out.cfl, m_fluid_out.max_div);
+    if (iterate) st += fmt::format("  iter {}  res {:.1e}", k + 1, res);
+    return st;
   });
+}
+
+// The stacked velocities of the elastic bodies (the unknowns of the coupled iterations).
+void Coupler::gather_velocities(const proto::SolidState& s, std::vector<double>& x) const {
+  x.clear();
+  for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
+    if (m_meshes.bodies[b].kind == 0) x.insert(x.end(), s.v[b].begin(), s.v[b].end());
+}
+
+void Coupler::scatter_velocities(const std::vector<double>& x, proto::SolidState& s) const {
+  std::size_t i = 0;
+  for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
+    if (m_meshes.bodies[b].kind == 0)
+      for (double& v : s.v[b]) v = x[i++];
 }
 
 // "bar, cylinder", or "none": the bodies' names for error messages.
@@ -429,12 +580,13 @@ void Coupler::resolve_roots() {
 
 // Root pose of each attached fiber from the current solid state: the material point of its edge,
 // and the edge's outward normal (the body lies on the left of a -> b).
-void Coupler::root_poses(std::vector<std::vector<double>>& poses) const {
+void Coupler::root_poses(const proto::SolidState& state,
+                         std::vector<std::vector<double>>& poses) const {
   poses.assign(m_layout.fibers.size(), {});
   for (std::size_t k = 0; k < m_roots.size(); ++k) {
     const Root& r = m_roots[k];
     if (r.body < 0) continue;
-    const auto& x = m_solid.x[r.body];
+    const auto& x = state.x[r.body];
     const double ax = x[2 * r.a], ay = x[2 * r.a + 1], dx = x[2 * r.b] - ax, dy = x[2 * r.b + 1] - ay;
     const double len = std::hypot(dx, dy);
     poses[k] = {ax + r.s * dx, ay + r.s * dy, dy / len, -dx / len};
@@ -446,13 +598,13 @@ void Coupler::root_poses(std::vector<std::vector<double>>& poses) const {
 //   f_a = (1 − s) F − q n,  f_b = s F + q n,  n = (−t_y, t_x), q = M / L,
 // with t the edge's unit tangent and L its length: the resultant is F, and the moment about p is
 // (1 − s)(x_a − p) × F + s (x_b − p) × F + q (x_b − x_a) × n = 0 + q L = M, exactly.
-void Coupler::add_root_loads() {
+void Coupler::add_root_loads(const proto::SolidState& state) {
   for (std::size_t k = 0; k < m_roots.size(); ++k) {
     const Root& r = m_roots[k];
     if (r.body < 0 || m_fiber.root_load.size() < 3 * (k + 1)) continue;
     const double fx = m_fiber.root_load[3 * k], fy = m_fiber.root_load[3 * k + 1];
     const double M = m_fiber.root_load[3 * k + 2];
-    const auto& x = m_solid.x[r.body];
+    const auto& x = state.x[r.body];
     const double dx = x[2 * r.b] - x[2 * r.a], dy = x[2 * r.b + 1] - x[2 * r.a + 1];
     const double len = std::hypot(dx, dy);
     const double q = M / len, nx = -dy / len, ny = dx / len;
@@ -493,15 +645,16 @@ void Coupler::feedback_forces() {
 // inertia of the fluid the forcing carries inside the body (DESIGN.md §4.2: ∫ f_s = ρ_f V a_s −
 // traction), from the bodies' momentum change over the previous step (the state at t^n is the
 // newest the coupler holds when the reaction is known).
-void Coupler::write_force_probes(long n) {
+void Coupler::write_force_probes(long n, const proto::SolidState& start,
+                                 const std::vector<std::vector<double>>& reaction) {
   if (!m_probes) return;
   const auto& bodies = m_meshes.bodies;
   const double dt = m_rt.settings().dt;
   // Per body, once: the reaction's resultant plus the rate of the carried fluid momentum.
   m_body_force.assign(bodies.size(), {0.0, 0.0});
   for (std::size_t b = 0; b < bodies.size(); ++b) {
-    const auto p = body_momentum(bodies[b], m_solid.x[b], m_solid.v[b], m_grid.density);
-    const auto& f = m_solid_in.force[b];
+    const auto p = body_momentum(bodies[b], start.x[b], start.v[b], m_grid.density);
+    const auto& f = reaction[b];
     for (std::size_t k = 0; k < f.size(); ++k) m_body_force[b][k % 2] += f[k];
     for (int c = 0; c < 2; ++c) m_body_force[b][c] += (p[c] - m_momentum[b][c]) / dt;
     m_momentum[b] = p;
@@ -537,9 +690,124 @@ void Coupler::finish() {
   j["coupler"]["steps_per_second"] = s.steps / loop;
   j["coupler"]["us_per_step"] = 1e6 * loop / s.steps;
   j["coupler"]["phases"] = nlohmann::json::parse(m_phases.to_json().dump());
+  if (m_accel) {
+    const char* method = m_iter.method == IterationSettings::Method::aitken     ? "aitken"
+                         : m_iter.method == IterationSettings::Method::constant ? "constant"
+                                                                                : "iqn-ils";
+    j["coupler"]["iterations"] = {
+        {"max", m_iter.max},
+        {"tolerance", m_iter.tolerance},
+        {"acceleration", method},
+        {"relaxation", m_iter.relaxation},
+        {"reuse", m_iter.reuse},
+        {"total", m_iter_total},
+        {"mean_per_step", s.steps > 0 ? double(m_iter_total) / double(s.steps) : 0.0},
+        {"max_per_step", m_iter_max},
+        {"not_converged_steps", m_not_converged},
+        {"largest_final_residual", m_residual_max}};
+  }
   fsi::write_summary(m_rt, j);
   m_progress->finish(s.steps, fsi::step_time(s, s.steps),
                      fmt::format("output in {}", m_rt.out_dir().string()));
+}
+
+void Acceleration::begin_step() {
+  m_k = 0;
+  m_now = {};
+  m_omega = m_s.relaxation;
+  m_columns = 0;
+}
+
+void Acceleration::end_step() {
+  if (m_s.method != IterationSettings::Method::iqn_ils || m_s.reuse == 0) return;
+  if (!m_now.v.empty()) m_old.insert(m_old.begin(), std::move(m_now));
+  if (static_cast<int>(m_old.size()) > m_s.reuse) m_old.resize(static_cast<std::size_t>(m_s.reuse));
+  m_now = {};
+}
+
+void Acceleration::update(const std::vector<double>& x, const std::vector<double>& xt,
+                          std::vector<double>& next) {
+  const std::size_t n = x.size();
+  std::vector<double> r(n);
+  for (std::size_t i = 0; i < n; ++i) r[i] = xt[i] - x[i];
+  next.resize(n);
+  using Method = IterationSettings::Method;
+  if (m_k > 0 && m_s.method == Method::aitken) {
+    // w_k = -w_(k-1) r^(k-1).(r^k - r^(k-1)) / |r^k - r^(k-1)|^2, bounded.
+    double num = 0, den = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double d = r[i] - m_r_prev[i];
+      num += m_r_prev[i] * d, den += d * d;
+    }
+    if (den > 0) m_omega = std::clamp(-m_omega * num / den, -kAitkenMax, kAitkenMax);
+  }
+  if (m_k > 0 && m_s.method == Method::iqn_ils) {
+    std::vector<double> dv(n), dw(n);
+    for (std::size_t i = 0; i < n; ++i) dv[i] = r[i] - m_r_prev[i], dw[i] = xt[i] - m_xt_prev[i];
+    m_now.v.insert(m_now.v.begin(), std::move(dv));
+    m_now.w.insert(m_now.w.begin(), std::move(dw));
+  }
+  m_r_prev = r;
+  m_xt_prev = xt;
+  ++m_k;
+
+  // The columns, newest first: this step's, then the kept steps'. Filter: modified
+  // Gram-Schmidt (twice) against the kept ones; a column whose orthogonal part is below
+  // kFilter of its length adds nothing the newer ones do not say, and is dropped for good.
+  std::vector<std::pair<Pairs*, std::size_t>> cols;
+  if (m_s.method == Method::iqn_ils) {
+    std::vector<std::vector<double>> q;
+    auto consider = [&](Pairs& p) {
+      for (std::size_t c = 0; c < p.v.size();) {
+        if (q.size() >= n) {  // as many columns as unknowns: the rest cannot help
+          p.v.erase(p.v.begin() + c), p.w.erase(p.w.begin() + c);
+          continue;
+        }
+        std::vector<double> a = p.v[c];
+        double len = 0;
+        for (double z : a) len += z * z;
+        len = std::sqrt(len);
+        for (int pass = 0; pass < 2; ++pass)
+          for (const auto& b : q) {
+            double d = 0;
+            for (std::size_t i = 0; i < n; ++i) d += a[i] * b[i];
+            for (std::size_t i = 0; i < n; ++i) a[i] -= d * b[i];
+          }
+        double rest = 0;
+        for (double z : a) rest += z * z;
+        rest = std::sqrt(rest);
+        if (!(len > 0) || rest < kFilter * len) {
+          p.v.erase(p.v.begin() + c), p.w.erase(p.w.begin() + c);
+          continue;
+        }
+        for (double& z : a) z /= rest;
+        q.push_back(std::move(a));
+        cols.push_back({&p, c});
+        ++c;
+      }
+    };
+    consider(m_now);
+    for (auto& p : m_old) consider(p);
+  }
+  m_columns = static_cast<int>(cols.size());
+  if (cols.empty()) {
+    for (std::size_t i = 0; i < n; ++i) next[i] = x[i] + m_omega * r[i];
+    return;
+  }
+  // c = argmin |V c + r| by Householder QR; x^(k+1) = x~^k + W c.
+  const Eigen::Index m = static_cast<Eigen::Index>(cols.size());
+  Eigen::MatrixXd V(static_cast<Eigen::Index>(n), m);
+  for (Eigen::Index j = 0; j < m; ++j) {
+    const auto& col = cols[j].first->v[cols[j].second];
+    for (std::size_t i = 0; i < n; ++i) V(static_cast<Eigen::Index>(i), j) = col[i];
+  }
+  const Eigen::Map<const Eigen::VectorXd> rv(r.data(), static_cast<Eigen::Index>(n));
+  const Eigen::VectorXd c = V.householderQr().solve(-rv);
+  next = xt;
+  for (Eigen::Index j = 0; j < m; ++j) {
+    const auto& w = cols[j].first->w[cols[j].second];
+    for (std::size_t i = 0; i < n; ++i) next[i] += c[j] * w[i];
+  }
 }
 
 }  // namespace coupler

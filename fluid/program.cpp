@@ -68,7 +68,10 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
   c.fiber_v_force = in.force_v.force;
   c.sample_u_index = in.sample_u;
   c.sample_v_index = in.sample_v;
-  m_solver->step(s.dt, c, m_out);
+  if (s.iteration == 0)
+    m_solver->step(s.dt, c, m_out);
+  else
+    m_solver->redo_step(s.dt, c, m_out);
   out.fs_u = m_out.solid_u_force;
   out.fs_v = m_out.solid_v_force;
   out.u_sample = m_out.sample_u;
@@ -165,6 +168,7 @@ nlohmann::json FluidProgram::report() const {
   nlohmann::json j;
   j["grid"] = {m_solver->grid().nx(), m_solver->grid().ny()};
   j["steps"] = tm.steps;
+  if (tm.repeats > 0) j["repeated_steps"] = tm.repeats;
   j["phases"] = {{"predictor", tm.predictor}, {"boundaries", tm.boundaries},
                  {"poisson", tm.poisson}, {"projection", tm.projection}};
   j["ns_per_cell_step"] = 1e9 * total / (cells * steps);

@@ -19,6 +19,7 @@ class FluidProgram : public fsi::FluidPort {
   fsi::proto::GridInfo grid_info() const override;
   void advance(const fsi::proto::StepBegin& s, const fsi::proto::FluidInput& in,
                fsi::proto::FluidOutput& out) override;
+  bool can_iterate() const override { return true; }
   void output(long step, double t, bool fields) override;
   std::string status() const override;
   nlohmann::json report() const override;

@@ -188,6 +188,37 @@ void Solver::step(double dt, const CouplingIn& in, CouplingOut& out) {
   } else {
     predictor(dt, m_t + 0.5 * dt, &in);
   }
+  // Kept for coupled iterations, which redo the rest of the step from here.
+  m_u_pred = m_u;
+  m_v_pred = m_v;
+  m_p_start = m_p;
+  m_t_start = m_t;
+  m_dt_prev_start = m_dt_prev;
+  m_time.predictor += since(t0);
+  finish_step(dt, in, out);
+  ++m_time.steps;
+}
+
+void Solver::redo_step(double dt, const CouplingIn& in, CouplingOut& out) {
+  if (m_step == 0 || dt != m_dt_prev)
+    throw std::invalid_argument("fluid::Solver::redo_step: no step of this dt to redo");
+  // Back to the end of the predictor: u~, p^n, the explicit terms in their step-n slots.
+  m_u = m_u_pred;
+  m_v = m_v_pred;
+  m_p = m_p_start;
+  std::swap(m_hu, m_hu_old);
+  std::swap(m_hv, m_hv_old);
+  m_t = m_t_start;
+  m_dt_prev = m_dt_prev_start;
+  --m_step;
+  finish_step(dt, in, out);
+  ++m_time.repeats;
+}
+
+// The step after the predictor: immersed forcing, projection, boundary ghosts, samples of
+// u^(n+1); then t^n -> t^(n+1).
+void Solver::finish_step(double dt, const CouplingIn& in, CouplingOut& out) {
+  auto t0 = Clock::now();
   immersed_forcing(dt, in, out);
   m_time.predictor += since(t0);
 
@@ -211,9 +242,8 @@ void Solver::step(double dt, const CouplingIn& in, CouplingOut& out) {
   std::swap(m_hu, m_hu_old);
   std::swap(m_hv, m_hv_old);
   m_dt_prev = dt;
-  m_t = t_new;
+  m_t += dt;
   ++m_step;
-  ++m_time.steps;
 }
 
 // Explicit predictor (AB2 for convection and diffusion, Euler on the first step):

@@ -52,6 +52,7 @@ struct CouplingOut {
 struct Timings {
   double predictor = 0, boundaries = 0, poisson = 0, projection = 0;
   long steps = 0;
+  long repeats = 0;  // steps redone (coupled iterations), not in `steps`
 };
 
 class Solver {
@@ -70,6 +71,10 @@ class Solver {
 
   void step(double dt);
   void step(double dt, const CouplingIn& in, CouplingOut& out);
+  // Coupled iterations: the step just taken again from its predictor u~ and p^n (kept by
+  // step()), with new solid input: immersed forcing, projection, samples. The fibers' force
+  // and the predictor are not recomputed (in.fiber_* is ignored). dt must be that of the step.
+  void redo_step(double dt, const CouplingIn& in, CouplingOut& out);
 
   // Fields. u: (nx+1) x ny, v: nx x (ny+1), p: nx x ny, with ghosts (Field). After set-up of
   // u and v by hand, call project_initial().
@@ -99,6 +104,7 @@ class Solver {
   void predictor_implicit(double dt, double t_half, const CouplingIn* in);
   void immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out);
   void project(double dt);
+  void finish_step(double dt, const CouplingIn& in, CouplingOut& out);
   int buf_index(int i, int j, int i_first, int j_first, int nt) const {
     return m_t_axis == 0 ? (i - i_first) + nt * (j - j_first) : (j - j_first) + nt * (i - i_first);
   }
@@ -114,6 +120,9 @@ class Solver {
   double m_nu = 0;
   Field m_u, m_v, m_p, m_phi;
   Field m_hu, m_hv, m_hu_old, m_hv_old, m_lu, m_lv;
+  // The last step's predictor u~ and p^n, and its t^n and dt' (for redo_step).
+  Field m_u_pred, m_v_pred, m_p_start;
+  double m_t_start = 0, m_dt_prev_start = 0;
   std::unique_ptr<FastSolver> m_poisson, m_helm_u, m_helm_v;
   Timings m_time;
 };

@@ -155,6 +155,12 @@ void SolidProgram::advance(const fsi::proto::StepBegin& sb, const fsi::proto::So
     if (b < static_cast<int>(in.force.size()) && m_solver->kind(b) == BodyKind::elastic)
       m_external[b] = in.force[b];
   }
+  // Coupled iterations: iteration 0 keeps the state the step starts from, a repeat goes back
+  // to it. A solver without iterations (max = 1) pays one copy of its state per step.
+  if (sb.iteration == 0)
+    m_solver->save_state(m_start);
+  else
+    m_solver->restore_state(m_start);
   try {
     if (m_cfg.model.settings.analysis == Analysis::statics) {
       // A static analysis walks the load factor t / t_end over the scene's steps.
@@ -167,7 +173,10 @@ void SolidProgram::advance(const fsi::proto::StepBegin& sb, const fsi::proto::So
     write_fields(sb.step + 1, sb.time + sb.dt);  // the last state, for a look at what went wrong
     throw;
   }
-  m_steps++;
+  if (sb.iteration == 0)
+    m_steps++;
+  else
+    m_repeats++;
   m_newton_total += m_last.iterations;
   m_newton_max = std::max<long>(m_newton_max, m_last.iterations);
   m_assembly += m_last.assembly_seconds;
@@ -267,6 +276,7 @@ nlohmann::json SolidProgram::report() const {
   j["analysis"] = m_cfg.model.settings.analysis == Analysis::statics ? "static" : "dynamic";
   j["equations"] = s.num_equations();
   j["steps"] = m_steps;
+  if (m_repeats > 0) j["repeated_steps"] = m_repeats;
   j["newton_iterations"] = m_newton_total;
   j["newton_iterations_max"] = m_newton_max;
   j["phases"] = {{"assembly", m_assembly}, {"factorization", m_factor}, {"solve", m_solve}};

@@ -24,6 +24,7 @@ class SolidProgram : public fsi::SolidPort {
   fsi::proto::BodyMeshes meshes() const override;
   void state(fsi::proto::SolidState& s) const override;
   void advance(const fsi::proto::StepBegin& s, const fsi::proto::SolidInput& in) override;
+  bool can_iterate() const override { return true; }
   void output(long step, double t, bool fields) override;
   std::string status() const override;
   nlohmann::json report() const override;
@@ -43,7 +44,8 @@ class SolidProgram : public fsi::SolidPort {
   std::vector<std::vector<double>> m_external;
   Modes m_modes;
   StepReport m_last;
-  long m_newton_total = 0, m_newton_max = 0, m_steps = 0, m_written_step = -1;
+  StepState m_start;  // the state the current step started from (coupled iterations)
+  long m_newton_total = 0, m_newton_max = 0, m_steps = 0, m_repeats = 0, m_written_step = -1;
   double m_assembly = 0, m_factor = 0, m_solve = 0;
 };
 

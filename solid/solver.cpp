@@ -942,6 +942,32 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
   return rep;
 }
 
+void Solver::save_state(StepState& s) const {
+  const std::size_t nb = m_bodies.size();
+  s.u.resize(nb), s.v.resize(nb), s.ma.resize(nb), s.x.resize(nb), s.contact.resize(nb);
+  for (std::size_t b = 0; b < nb; ++b) {
+    const Body& B = *m_bodies[b];
+    s.u[b] = B.u, s.v[b] = B.v, s.ma[b] = B.ma, s.x[b] = B.x, s.contact[b] = B.contact;
+  }
+  s.slots = m_contact.slots();
+  s.time = m_time;
+  s.step = m_step;
+  s.contact_force_factor = m_contact_force_factor;
+}
+
+void Solver::restore_state(const StepState& s) {
+  if (s.u.size() != m_bodies.size()) fsi::fail("solid: restore_state: a state of another model");
+  for (std::size_t b = 0; b < m_bodies.size(); ++b) {
+    Body& B = *m_bodies[b];
+    B.u = s.u[b], B.v = s.v[b], B.ma = s.ma[b], B.x = s.x[b], B.contact = s.contact[b];
+  }
+  m_contact.slots() = s.slots;
+  m_time = s.time;
+  m_step = s.step;
+  m_contact_force_factor = s.contact_force_factor;
+  m_dirichlet_pending = false;
+}
+
 StepReport Solver::solve_static_step(double factor) {
   const std::string when = fmt::format("load factor {:.6g}", factor);
   prepare_prescribed(factor);

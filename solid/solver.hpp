@@ -38,6 +38,17 @@ struct Modes {
       shapes;  // [mode][body] nodal (x0, y0, ...), M-normalised
 };
 
+// The state a step starts from, for coupled iterations that redo a step: every body's
+// displacements, velocities, M a, positions and contact forces, the contact slots (active set,
+// multipliers), the clock. Opaque outside the solver.
+struct StepState {
+  std::vector<std::vector<double>> u, v, ma, x, contact;
+  std::vector<ContactSlot> slots;
+  double time = 0;
+  long step = 0;
+  double contact_force_factor = 1;
+};
+
 class Solver {
  public:
   // Validates the model (throws fsi::InputError for bad input), numbers the equations, builds
@@ -60,6 +71,11 @@ class Solver {
   // element inverts (det F <= 0) or a value is not finite; the message names body, element or
   // node, step and time.
   StepReport advance(double dt, const std::vector<std::vector<double>>* external = nullptr);
+
+  // Coupled iterations: keep the current state / go back to a kept one (then advance() redoes
+  // the step from it and gives bit for bit what it gave the first time with the same forces).
+  void save_state(StepState& s) const;
+  void restore_state(const StepState& s);
 
   // Static analysis: the loads and prescribed displacements scaled by k / load_steps,
   // k = 1 ... load_steps, each solved by Newton. Returns the report of every load step.

@@ -17,8 +17,9 @@ M round_trip(const M& m, std::int64_t step = 7) {
 }
 
 TEST_CASE("every message survives a round trip") {
-  GridInfo g{3, 2, 1, 0, {0, 0.5, 1, 1.5}, {0, 0.1, 0.3}, 1000.0};
+  GridInfo g{3, 2, 1, 0, {0, 0.5, 1, 1.5}, {0, 0.1, 0.3}, 1000.0, 1};
   const auto g2 = round_trip(g);
+  CHECK(g2.can_iterate == 1);
   CHECK(g2.nx == 3);
   CHECK(g2.periodic_x == 1);
   CHECK(g2.y_face == g.y_face);
@@ -27,7 +28,9 @@ TEST_CASE("every message survives a round trip") {
   BodyMeshes bm;
   bm.bodies.push_back({"bar", 0, {0, 0, 1, 0, 0, 1}, {0, 1, 2}, {0, 1, 1, 2, 2, 0}});
   bm.bodies.push_back({"cylinder", 1, {}, {}, {}});
+  bm.can_iterate = 1;
   const auto bm2 = round_trip(bm);
+  CHECK(bm2.can_iterate == 1);
   REQUIRE(bm2.bodies.size() == 2);
   CHECK(bm2.bodies[0].name == "bar");
   CHECK(bm2.bodies[0].tri == bm.bodies[0].tri);
@@ -44,9 +47,10 @@ TEST_CASE("every message survives a round trip") {
   Text t{Tag::final_report, "{\"a\": 1}"};
   CHECK(round_trip(t).text == t.text);
 
-  StepBegin sb{41, 0.041, 1e-3, Action::stop};
+  StepBegin sb{41, 0.041, 1e-3, Action::stop, 3};
   const auto sb2 = round_trip(sb);
   CHECK(sb2.step == 41);
+  CHECK(sb2.iteration == 3);
   CHECK(sb2.action == Action::stop);
 
   FluidInput fi;

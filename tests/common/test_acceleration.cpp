@@ -1,0 +1,149 @@
+// The coupler's acceleration of the coupled iterations (coupler.hpp, Acceleration) on linear
+// fixed points x = J x + c with a known solution: IQN-ILS, Aitken and constant relaxation.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+#include "coupler.hpp"
+
+using coupler::Acceleration;
+using coupler::IterationSettings;
+
+namespace {
+
+// J = -Q diag(mu) Q^T with a random orthogonal Q: the eigenvalues -mu of the explicit coupling's
+// amplification (real, negative: the lagged inertia overshoots). Returns the iterations needed
+// for |x~ - x| <= tol |x~|, or -1 after max.
+struct Linear {
+  int n;
+  std::vector<double> J, c, solution;
+  Linear(const std::vector<double>& mu, unsigned seed) : n(static_cast<int>(mu.size())) {
+    std::mt19937 gen(seed);
+    std::normal_distribution<double> g;
+    // Q from Gram-Schmidt on random columns.
+    std::vector<std::vector<double>> q;
+    while (static_cast<int>(q.size()) < n) {
+      std::vector<double> a(n);
+      for (double& z : a) z = g(gen);
+      for (const auto& b : q) {
+        double d = 0;
+        for (int i = 0; i < n; ++i) d += a[i] * b[i];
+        for (int i = 0; i < n; ++i) a[i] -= d * b[i];
+      }
+      double l = 0;
+      for (double z : a) l += z * z;
+      for (double& z : a) z /= std::sqrt(l);
+      q.push_back(a);
+    }
+    J.assign(n * n, 0.0);
+    for (int k = 0; k < n; ++k)
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) J[i * n + j] -= mu[k] * q[k][i] * q[k][j];
+    solution.resize(n);
+    for (double& z : solution) z = g(gen);
+    c = solution;  // c = (I - J) x*
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) c[i] -= J[i * n + j] * solution[j];
+  }
+  std::vector<double> operator()(const std::vector<double>& x) const {
+    std::vector<double> y = c;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) y[i] += J[i * n + j] * x[j];
+    return y;
+  }
+};
+
+int solve(const Linear& H, Acceleration& a, std::vector<double>& x, int max, double tol) {
+  a.begin_step();
+  std::vector<double> next;
+  for (int k = 0; k < max; ++k) {
+    const auto xt = H(x);
+    double r = 0, v = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) r += (xt[i] - x[i]) * (xt[i] - x[i]), v += xt[i] * xt[i];
+    if (std::sqrt(r) <= tol * std::sqrt(v)) {
+      a.end_step();
+      return k + 1;
+    }
+    a.update(x, xt, next);
+    x = next;
+  }
+  a.end_step();
+  return -1;
+}
+
+double error(const Linear& H, const std::vector<double>& x) {
+  double e = 0, s = 0;
+  for (int i = 0; i < H.n; ++i) e += std::pow(x[i] - H.solution[i], 2), s += std::pow(H.solution[i], 2);
+  return std::sqrt(e / s);
+}
+
+}  // namespace
+
+TEST_CASE("IQN-ILS solves a strongly amplifying linear coupling in about as many iterations as it has amplified modes") {
+  // 6 modes amplified 50 to 5000 times (the explicit coupling's blow-up), 34 damped ones.
+  std::vector<double> mu{5000, 1200, 400, 150, 60, 50};
+  mu.resize(40, 0.3);
+  const Linear H(mu, 7);
+  IterationSettings s;
+  s.method = IterationSettings::Method::iqn_ils;
+  Acceleration a(s);
+  std::vector<double> x(40, 0.0);
+  const int its = solve(H, a, x, 60, 1e-10);
+  INFO("iterations " << its);
+  CHECK(its > 0);
+  CHECK(its <= 20);
+  CHECK(error(H, x) < 1e-9);
+}
+
+TEST_CASE("IQN-ILS with reuse needs fewer iterations on the next step of the same coupling") {
+  std::vector<double> mu{5000, 1200, 400, 150, 60, 50};
+  mu.resize(40, 0.3);
+  const Linear H(mu, 11);
+  IterationSettings s;
+  s.reuse = 2;
+  Acceleration a(s);
+  std::vector<double> x(40, 0.0);
+  const int first = solve(H, a, x, 60, 1e-8);
+  for (double& z : x) z *= 0.9;  // the next step starts near the solution
+  const int second = solve(H, a, x, 60, 1e-8);
+  INFO("first " << first << ", second " << second);
+  REQUIRE(first > 0);
+  REQUIRE(second > 0);
+  CHECK(second <= 3);
+  CHECK(second < first);
+  CHECK(error(H, x) < 1e-7);
+}
+
+TEST_CASE("Aitken relaxation converges on one dominant amplified mode; constant relaxation does not") {
+  std::vector<double> mu{20};
+  mu.resize(10, 0.2);
+  const Linear H(mu, 3);
+  IterationSettings s;
+  s.method = IterationSettings::Method::aitken;
+  Acceleration aitken(s);
+  std::vector<double> x(10, 0.0);
+  const int its = solve(H, aitken, x, 100, 1e-8);
+  INFO("Aitken iterations " << its);
+  CHECK(its > 0);
+  CHECK(error(H, x) < 1e-6);
+  // Constant 0.5: the mode of -20 maps the error by 1 - 0.5 (1 + 20) = -9.5 per iteration.
+  s.method = IterationSettings::Method::constant;
+  Acceleration constant(s);
+  std::vector<double> y(10, 0.0);
+  CHECK(solve(H, constant, y, 100, 1e-8) == -1);
+}
+
+TEST_CASE("constant relaxation below 2 / (1 + mu_max) converges") {
+  std::vector<double> mu{1.0, 0.5, 0.2};
+  const Linear H(mu, 5);
+  IterationSettings s;
+  s.method = IterationSettings::Method::constant;
+  s.relaxation = 0.5;  // error factors 1 - 0.5 (1 + mu): 0, 0.25, 0.4
+  Acceleration a(s);
+  std::vector<double> x(3, 0.0);
+  const int its = solve(H, a, x, 100, 1e-10);
+  CHECK(its > 0);
+  CHECK(its <= 30);
+  CHECK(error(H, x) < 1e-9);
+}
