@@ -165,6 +165,11 @@ void Coupler::setup() {
     }
   }
   check_can_iterate();
+  m_h_min = 1e300;
+  for (std::size_t i = 0; i + 1 < m_grid.x_face.size(); ++i)
+    m_h_min = std::min(m_h_min, m_grid.x_face[i + 1] - m_grid.x_face[i]);
+  for (std::size_t j = 0; j + 1 < m_grid.y_face.size(); ++j)
+    m_h_min = std::min(m_h_min, m_grid.y_face[j + 1] - m_grid.y_face[j]);
   const auto& bodies = m_meshes.bodies;
   if (!bodies.empty()) {
     if (!has(Role::fluid))
@@ -435,8 +440,9 @@ void Coupler::step(long n) {
     }
     if (!iterate) break;
     // Residual of the fixed point v = H(v) over every elastic body's nodes, against |v^(k+1)|
-    // with a floor at 1 % of the largest velocity of the run so far (a body passing through
-    // rest keeps an attainable target).
+    // with a floor: 1 % of the fluid's fastest speed at every node, U = CFL h_min / dt (a lower
+    // bound of max |u| from the fluid's CFL number). A body at rest in a moving fluid (a steady
+    // state, a start from rest) then keeps an attainable target instead of one at round-off.
     m_phases.start("iterations");
     gather_velocities(*footprint, m_x_in);
     gather_velocities(m_solid, m_x_out);
@@ -445,7 +451,9 @@ void Coupler::step(long n) {
       const double d = m_x_out[i] - m_x_in[i];
       r2 += d * d, v2 += m_x_out[i] * m_x_out[i];
     }
-    const double scale = std::max(std::sqrt(v2), 0.01 * m_v_scale);
+    const double u_fluid = m_fluid_out.cfl * m_h_min / s.dt;
+    const double floor = 0.01 * u_fluid * std::sqrt(static_cast<double>(m_x_in.size()));
+    const double scale = std::max(std::sqrt(v2), floor);
     res = scale > 0 ? std::sqrt(r2) / scale : (r2 > 0 ? 1.0 : 0.0);
     if (k == 0) res_first = res;
     converged = res <= m_iter.tolerance;
@@ -468,10 +476,6 @@ void Coupler::step(long n) {
     m_iter_total += its;
     m_iter_max = std::max(m_iter_max, its);
     m_residual_max = std::max(m_residual_max, res);
-    double v2 = 0;
-    for (const auto& v : m_solid.v)
-      for (double x : v) v2 += x * x;
-    m_v_scale = std::max(m_v_scale, std::sqrt(v2));
     if (!converged) {
       ++m_not_converged;
       if (m_not_converged <= 20)

@@ -165,7 +165,7 @@ class Coupler {
   proto::SolidState m_start, m_guess;
   std::vector<std::vector<double>> m_v_before, m_reaction;
   std::vector<double> m_x_in, m_x_out, m_x_next;
-  double m_v_scale = 0;  // largest |v| of a committed step: the tolerance's floor
+  double m_h_min = 0;  // smallest grid spacing (the tolerance's floor, from the fluid's CFL)
   long m_iter_total = 0, m_iter_max = 0, m_not_converged = 0;
   double m_residual_max = 0;
   std::unique_ptr<fsi::ProbeCsv> m_iter_csv;
