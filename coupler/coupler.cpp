@@ -9,10 +9,8 @@
 #include <sstream>
 #include <toml.hpp>
 
-// Eigen is header-only; the coupler library does not link its CMake target, so the header is
-// named through its install folder.
-#include <eigen3/Eigen/Core>
-#include <eigen3/Eigen/QR>
+#include <Eigen/Core>
+#include <Eigen/QR>
 
 #include "driver.hpp"
 
