@@ -470,7 +470,7 @@ void Coupler::step(long n) {
   }
   if (iterate) {
     const long its = k + 1;
-    m_accel->end_step();
+    m_accel->end_step(converged);
     m_iter_total += its;
     m_iter_max = std::max(m_iter_max, its);
     m_residual_max = std::max(m_residual_max, res);
@@ -720,8 +720,16 @@ void Acceleration::begin_step() {
   m_columns = 0;
 }
 
-void Acceleration::end_step() {
+void Acceleration::end_step(bool converged) {
   if (m_s.method != IterationSettings::Method::iqn_ils || m_s.reuse == 0) return;
+  // A step that did not converge may hold nearly dependent pairs (a steady state: differences of
+  // velocities at the tolerance's floor) that would steer the next steps' least squares far off:
+  // forget every kept pair and start the next step from the relaxation alone.
+  if (!converged) {
+    m_old.clear();
+    m_now = {};
+    return;
+  }
   if (!m_now.v.empty()) m_old.insert(m_old.begin(), std::move(m_now));
   if (static_cast<int>(m_old.size()) > m_s.reuse) m_old.resize(static_cast<std::size_t>(m_s.reuse));
   m_now = {};

@@ -53,8 +53,9 @@ class Acceleration {
   explicit Acceleration(const IterationSettings& s) : m_s(s) {}
   void begin_step();
   void update(const std::vector<double>& x, const std::vector<double>& xt, std::vector<double>& next);
-  // The step is over (converged or not): its secant pairs join the kept ones (IQN-ILS, reuse).
-  void end_step();
+  // The step is over: a converged step's secant pairs join the kept ones (IQN-ILS, reuse); a
+  // step that did not converge clears them all.
+  void end_step(bool converged);
   double omega() const { return m_omega; }
   int columns() const { return m_columns; }  // columns used by the last IQN-ILS update
 

@@ -62,13 +62,13 @@ int solve(const Linear& H, Acceleration& a, std::vector<double>& x, int max, dou
     double r = 0, v = 0;
     for (std::size_t i = 0; i < x.size(); ++i) r += (xt[i] - x[i]) * (xt[i] - x[i]), v += xt[i] * xt[i];
     if (std::sqrt(r) <= tol * std::sqrt(v)) {
-      a.end_step();
+      a.end_step(true);
       return k + 1;
     }
     a.update(x, xt, next);
     x = next;
   }
-  a.end_step();
+  a.end_step(false);
   return -1;
 }
 
@@ -112,6 +112,35 @@ TEST_CASE("IQN-ILS with reuse needs fewer iterations on the next step of the sam
   REQUIRE(second > 0);
   CHECK(second <= 3);
   CHECK(second < first);
+  CHECK(error(H, x) < 1e-7);
+}
+
+TEST_CASE("IQN-ILS forgets its kept pairs after a step that did not converge") {
+  std::vector<double> mu{5000, 1200, 400, 150, 60, 50};
+  mu.resize(40, 0.3);
+  const Linear H(mu, 11);
+  IterationSettings s;
+  s.reuse = 2;
+  Acceleration a(s);
+  std::vector<double> x(40, 0.0);
+  const int first = solve(H, a, x, 60, 1e-8);
+  REQUIRE(first > 0);
+  // A step cut short: not converged, so the next step must start without kept pairs ...
+  std::vector<double> y(40, 0.0);
+  REQUIRE(solve(H, a, y, 1, 1e-8) == -1);
+  for (double& z : x) z *= 0.9;
+  const int after = solve(H, a, x, 60, 1e-8);
+  // ... and take the iterations of a fresh start from there, not the 2-3 of a reused one.
+  Acceleration fresh(s);
+  std::vector<double> w(40, 0.0);
+  REQUIRE(solve(H, fresh, w, 60, 1e-8) > 0);
+  for (double& z : w) z *= 0.9;
+  Acceleration fresh2(s);
+  const int fresh_count = solve(H, fresh2, w, 60, 1e-8);
+  INFO("first " << first << ", after a failed step " << after << ", fresh " << fresh_count);
+  REQUIRE(after > 0);
+  CHECK(after == fresh_count);
+  CHECK(after > 3);
   CHECK(error(H, x) < 1e-7);
 }
 
