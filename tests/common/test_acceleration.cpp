@@ -80,11 +80,15 @@ double error(const Linear& H, const std::vector<double>& x) {
 
 }  // namespace
 
-TEST_CASE("IQN-ILS solves a strongly amplifying linear coupling in about as many iterations as it has amplified modes") {
-  // 6 modes amplified 50 to 5000 times (the explicit coupling's blow-up), 34 damped ones.
+// 6 modes amplified 50 to 5000 times (the explicit coupling's blow-up), 34 damped ones.
+Linear amplifying(unsigned seed) {
   std::vector<double> mu{5000, 1200, 400, 150, 60, 50};
   mu.resize(40, 0.3);
-  const Linear H(mu, 7);
+  return Linear(mu, seed);
+}
+
+TEST_CASE("IQN-ILS solves a strongly amplifying linear coupling in about as many iterations as it has amplified modes") {
+  const Linear H = amplifying(7);
   IterationSettings s;
   s.method = IterationSettings::Method::iqn_ils;
   Acceleration a(s);
@@ -97,9 +101,7 @@ TEST_CASE("IQN-ILS solves a strongly amplifying linear coupling in about as many
 }
 
 TEST_CASE("IQN-ILS with reuse needs fewer iterations on the next step of the same coupling") {
-  std::vector<double> mu{5000, 1200, 400, 150, 60, 50};
-  mu.resize(40, 0.3);
-  const Linear H(mu, 11);
+  const Linear H = amplifying(11);
   IterationSettings s;
   s.reuse = 2;
   Acceleration a(s);
@@ -116,9 +118,7 @@ TEST_CASE("IQN-ILS with reuse needs fewer iterations on the next step of the sam
 }
 
 TEST_CASE("IQN-ILS forgets its kept pairs after a step that did not converge") {
-  std::vector<double> mu{5000, 1200, 400, 150, 60, 50};
-  mu.resize(40, 0.3);
-  const Linear H(mu, 11);
+  const Linear H = amplifying(11);
   IterationSettings s;
   s.reuse = 2;
   Acceleration a(s);
