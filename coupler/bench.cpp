@@ -99,13 +99,16 @@ int main(int argc, char** argv) {
               result[0][0], result[0][2], result[0][1]);
   std::printf("  two threads: footprint %.3f ms wall, reaction %.3f ms\n", result[1][0],
               result[1][1]);
-  std::printf("notes: change | predicted | measured (CPU ms of one thread, loaded machine)\n");
-  std::printf("  split each triangle along column then row lines (was: clip against every box) | 2x | "
-              "footprint phase 7.4 -> 7.3 ms in the coupled bench\n");
+  std::printf("notes: change | predicted | measured\n");
+  std::printf("  split each triangle along the column, then the row lines (was: clip against every "
+              "box) | 2x | with the two below: footprint phase of ./fsi bench coupled 7.4 -> 4.1 ms "
+              "(idle machine)\n");
   std::printf("  pieces stay in clipping order, per-face sums by slot (was: counting sort) | -15 %% | "
-              "5.8 (both changes above, first measured here)\n");
-  std::printf("  box index by one division (was: 4 binary searches per triangle); skip uncrossed lines "
-              "| -30 %% | 5.0-5.8 -> 3.9-4.8\n");
+              "in the line above\n");
+  std::printf("  box index by one division (was: 4 binary searches per triangle); no split at lines "
+              "not crossed | -30 %% | 5.0-5.8 -> 3.9-4.8 ms CPU (loaded machine); 3.4-3.6 ms idle\n");
+  std::printf("  u- and v-families on two threads | 2x | 3.4 -> 2.6 ms (idle; the v-family is the "
+              "larger, and a thread is started per call)\n");
   if (out) {
     if (FILE* f = std::fopen(out, "w")) {
       std::fprintf(f,
