@@ -233,6 +233,15 @@ void Coupler::setup() {
   fsi::write_file_atomically(m_rt.out_dir() / "scene.effective.toml", toml::format(doc));
 }
 
+// The non-periodic boundary a point (x, y) is beyond, or nullptr when it is inside the domain.
+const char* Coupler::outside(double x, double y) const {
+  if (!m_grid.periodic_x && x < m_grid.x_face.front()) return "left";
+  if (!m_grid.periodic_x && x > m_grid.x_face.back()) return "right";
+  if (!m_grid.periodic_y && y < m_grid.y_face.front()) return "bottom";
+  if (!m_grid.periodic_y && y > m_grid.y_face.back()) return "top";
+  return nullptr;
+}
+
 // A body must stay inside the fluid domain, except across a periodic boundary.
 void Coupler::check_bodies_in_domain(long step) const {
   const double x0 = m_grid.x_face.front(), x1 = m_grid.x_face.back();
@@ -240,12 +249,7 @@ void Coupler::check_bodies_in_domain(long step) const {
   for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b) {
     const auto& x = m_solid.x[b];
     for (std::size_t k = 0; k + 1 < x.size(); k += 2) {
-      const char* side = nullptr;
-      if (!m_grid.periodic_x && x[k] < x0) side = "left";
-      else if (!m_grid.periodic_x && x[k] > x1) side = "right";
-      else if (!m_grid.periodic_y && x[k + 1] < y0) side = "bottom";
-      else if (!m_grid.periodic_y && x[k + 1] > y1) side = "top";
-      if (side)
+      if (const char* side = outside(x[k], x[k + 1]))
         fsi::fail("body '{}' is outside the fluid domain [{}, {}] x [{}, {}] through its {} "
                   "boundary at step {}: node {} at ({}, {})",
                   m_meshes.bodies[b].name, x0, x1, y0, y1, side, step, k / 2, x[k], x[k + 1]);
@@ -261,12 +265,7 @@ void Coupler::check_fibers_in_domain(long step) const {
   for (std::size_t k = 0; k < m_fiber.x.size() && k < m_layout.fibers.size(); ++k) {
     const auto& x = m_fiber.x[k];
     for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
-      const char* side = nullptr;
-      if (!m_grid.periodic_x && x[m] < x0) side = "left";
-      else if (!m_grid.periodic_x && x[m] > x1) side = "right";
-      else if (!m_grid.periodic_y && x[m + 1] < y0) side = "bottom";
-      else if (!m_grid.periodic_y && x[m + 1] > y1) side = "top";
-      if (side)
+      if (const char* side = outside(x[m], x[m + 1]))
         fsi::fail("fiber '{}' left the fluid domain [{}, {}] x [{}, {}] through its {} boundary "
                   "at step {}: marker {} at ({:.6g}, {:.6g})",
                   m_layout.fibers[k].name, x0, x1, y0, y1, side, step, m / 2, x[m], x[m + 1]);
@@ -412,10 +411,12 @@ void Coupler::step(long n) {
       for (Role r : {Role::fluid, Role::solid})
         if (has(r)) m_rt.link(r).send(sb, n);
     }
-    // 2: the bodies' footprint, α and ū_s, from x^n and the velocity estimate.
+    // 2: the bodies' footprint, α and ū_s, from x^n and the velocity estimate (the footprint of
+    // x^n is clipped once per step; an iteration only averages its new velocities).
     if (m_immersed) {
       m_phases.start("footprint");
-      m_immersed->update(*footprint, m_fluid_in.solid_u, m_fluid_in.solid_v);
+      if (k == 0) m_immersed->update(*footprint, m_fluid_in.solid_u, m_fluid_in.solid_v);
+      else m_immersed->update_velocities(*footprint, m_fluid_in.solid_u, m_fluid_in.solid_v);
       m_phases.stop("footprint");
     }
     // 3-4: the fluid step (or its forcing and projection again).

@@ -84,6 +84,7 @@ class Coupler {
   void step(long n);
   void finish();
   bool has(fsi::Role r) const { return m_rt.roles()[r]; }
+  const char* outside(double x, double y) const;
   void check_bodies_in_domain(long step) const;
   void check_fibers_in_domain(long step) const;
   void check_growth(long step);

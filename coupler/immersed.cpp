@@ -70,27 +70,25 @@ EdgeIndex::EdgeIndex(const std::vector<double>& e) : m_e(&e) {
   if (m_even) m_inv = 1.0 / h;
 }
 
-int EdgeIndex::last_at_or_below(double c) const {
+// The largest k with e[k] <= c (strict: e[k] < c), −1 when there is none.
+template <bool strict>
+int EdgeIndex::locate(double c) const {
   const std::vector<double>& e = *m_e;
   const int n = static_cast<int>(e.size()) - 1;
-  if (!m_even) return static_cast<int>(std::upper_bound(e.begin(), e.end(), c) - e.begin()) - 1;
+  auto below = [c](double edge) { return strict ? edge < c : edge <= c; };
+  if (!m_even)
+    return static_cast<int>(strict ? std::lower_bound(e.begin(), e.end(), c) - e.begin()
+                                   : std::upper_bound(e.begin(), e.end(), c) - e.begin()) -
+           1;
   const double g = std::floor((c - e[0]) * m_inv);
   int k = g < -1 ? -1 : (g > n ? n : static_cast<int>(g));
-  while (k >= 0 && e[k] > c) --k;
-  while (k < n && e[k + 1] <= c) ++k;
+  while (k >= 0 && !below(e[k])) --k;
+  while (k < n && below(e[k + 1])) ++k;
   return k;
 }
 
-int EdgeIndex::last_below(double c) const {
-  const std::vector<double>& e = *m_e;
-  const int n = static_cast<int>(e.size()) - 1;
-  if (!m_even) return static_cast<int>(std::lower_bound(e.begin(), e.end(), c) - e.begin()) - 1;
-  const double g = std::floor((c - e[0]) * m_inv);
-  int k = g < -1 ? -1 : (g > n ? n : static_cast<int>(g));
-  while (k >= 0 && e[k] >= c) --k;
-  while (k < n && e[k + 1] < c) ++k;
-  return k;
-}
+int EdgeIndex::last_at_or_below(double c) const { return locate<false>(c); }
+int EdgeIndex::last_below(double c) const { return locate<true>(c); }
 
 ImmersedSolid::ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshes& meshes)
     : m_meshes(meshes),
@@ -265,8 +263,8 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
   // The two families are independent (own boxes, pieces and scratch): the v-family runs on a
   // second thread while this one does the u-family. The other programs wait for this step's
   // messages meanwhile, so the second core is free.
-  auto family = [&](const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy, Raw& fixed, Raw& raw, Pieces& p, Scratch& s, int c,
-                    proto::FaceSolid& out) {
+  auto family = [&](const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy, Raw& fixed,
+                    Raw& raw, Pieces& p, Scratch& s, int c, proto::FaceSolid& out) {
     if (!m_fixed_done)
       for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
         if (bodies[b].kind == 1) clip_body(boxes, ix, iy, b, state.x[b], fixed);
@@ -285,6 +283,14 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
     family(m_vb, m_vx, m_vy, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v);
   }
   m_fixed_done = true;
+}
+
+void ImmersedSolid::update_velocities(const proto::SolidState& state, proto::FaceSolid& u,
+                                      proto::FaceSolid& v) const {
+  if (state.v.size() != m_meshes.bodies.size())
+    fsi::fail("solid state has {} bodies, the meshes {}", state.v.size(), m_meshes.bodies.size());
+  fill(m_ub, m_u, state, 0, u);
+  fill(m_vb, m_v, state, 1, v);
 }
 
 void ImmersedSolid::reaction(const std::vector<double>& fs_u, const std::vector<double>& fs_v,

@@ -40,6 +40,8 @@ class EdgeIndex {
   int last_below(double c) const;
 
  private:
+  template <bool strict>
+  int locate(double c) const;
   const std::vector<double>* m_e = nullptr;
   bool m_even = false;
   double m_inv = 0;
@@ -55,6 +57,10 @@ class ImmersedSolid {
   // exact because N_a is linear on each triangle T: ∫_P N_a dA = |P| N_a(centroid of P).
   // Rigid fixed bodies are clipped once and reused.
   void update(const proto::SolidState& state, proto::FaceSolid& u, proto::FaceSolid& v);
+  // The same faces and α as the last update(), ū_s from the velocities of `state` (whose positions
+  // must be those of that update): the coupled iterations change only the velocities.
+  void update_velocities(const proto::SolidState& state, proto::FaceSolid& u,
+                         proto::FaceSolid& v) const;
 
   // Step 6: the nodal force on every body, the exact reaction of f_s (force per unit volume on
   // the fluid, on the faces of the last update, in their order):
