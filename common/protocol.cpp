@@ -130,8 +130,8 @@ void FluidOutput::unpack(Reader& r) {
   r.get(cfl), r.get(max_div), r.get(kinetic_energy);
 }
 
-void SolidInput::pack(Writer& w) const { put_list(w, force); }
-void SolidInput::unpack(Reader& r) { get_list(r, force); }
+void SolidInput::pack(Writer& w) const { put_list(w, force), put_list(w, velocity); }
+void SolidInput::unpack(Reader& r) { get_list(r, force), get_list(r, velocity); }
 
 void SolidState::pack(Writer& w) const { w.put(time), put_list(w, x), put_list(w, v); }
 void SolidState::unpack(Reader& r) { r.get(time), get_list(r, x), get_list(r, v); }

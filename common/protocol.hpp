@@ -17,7 +17,7 @@
 namespace fsi::proto {
 
 // Bump on any change of a message's layout or of the message order.
-inline constexpr std::int32_t kVersion = 2;
+inline constexpr std::int32_t kVersion = 3;
 inline constexpr std::uint32_t kMagic = 0x4d495346;  // "FSIM"
 
 enum class Tag : std::int32_t {
@@ -215,6 +215,11 @@ struct SolidInput {  // coupler -> solid, every step
   // per body: nodal forces ON THE SOLID (2 per node), the exact reaction of f_s plus the
   // fibers' root loads as equivalent nodal forces. Empty for rigid bodies.
   std::vector<std::vector<double>> force;
+  // Coupled iterations only (empty in the explicit step): per body, the nodal velocities at
+  // t^(n+1) whose footprint average u_s the fluid's forcing of this pass used (v^n at iteration
+  // 0, the coupler's estimate after). The reaction depends on them as dF/dv ~ -M_f/dt (M_f the
+  // mass matrix of the fluid inside the body); a solid may use them to linearise it.
+  std::vector<std::vector<double>> velocity;
   void pack(Writer& w) const;
   void unpack(Reader& r);
 };

@@ -431,6 +431,13 @@ void Coupler::step(long n) {
     // Rigid bodies move by their law: their reaction is only measured, not sent.
     for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
       if (m_meshes.bodies[b].kind != 0) m_solid_in.force[b].clear();
+    // With iterations the solid also gets the velocities this pass's forcing used (protocol
+    // version 3): the reaction's linearisation dF/dv ~ -M_f/dt is about them.
+    if (iterate) {
+      m_solid_in.velocity = footprint->v;
+      for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
+        if (m_meshes.bodies[b].kind != 0) m_solid_in.velocity[b].clear();
+    }
     add_root_loads(m_start);
     // 7: the solid step (or the same step again from its state at t^n).
     if (has(Role::solid)) {

@@ -268,6 +268,7 @@ Config read_config(const fsi::SceneTable& s, double fluid_density) {
   st.newton_tolerance = s.positive("newton_tolerance", 1e-10);
   st.newton_max_iterations = static_cast<int>(s.positive_integer("newton_max_iterations", 30));
   st.contact_tolerance = s.positive("contact_tolerance", 1e-10);
+  st.iteration_fluid_mass = s.boolean("iteration_fluid_mass", true);
   c.modes = static_cast<int>(s.integer("modes", 0));
   if (c.modes < 0) s.fail("modes", fmt::format("must be >= 0, got {}", c.modes));
   c.initial_mode = static_cast<int>(s.integer("initial_mode", 0));

@@ -100,6 +100,9 @@ struct Settings {
   double newton_tolerance = 1e-10;  // on ||R|| relative to the force scale
   int newton_max_iterations = 30;
   double contact_tolerance = 1e-10;  // on the gap, relative to the smallest element edge
+  // Coupled iterations: linearise the fluid's reaction about the velocity the coupler used,
+  // dF/dv = -M_f/dt (solver.cpp, assemble). Vanishes at convergence.
+  bool iteration_fluid_mass = true;
 };
 
 struct Model {

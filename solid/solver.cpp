@@ -465,6 +465,15 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
       std::fill(B.f_cpl.begin(), B.f_cpl.end(), 0.0);
     }
     std::fill(B.q.begin(), B.q.end(), 0.0);
+    const std::vector<double>* iter_w = nullptr;
+    if (dynamic && m_iteration_velocity &&
+        static_cast<int>(m_iteration_velocity->size()) > B.index &&
+        !(*m_iteration_velocity)[B.index].empty()) {
+      iter_w = &(*m_iteration_velocity)[B.index];
+      if (iter_w->size() != B.u.size())
+        fsi::fail("solid: iteration velocities for body '{}' have {} values, expected {}",
+                  B.spec.name, iter_w->size(), B.u.size());
+    }
     std::vector<double>& r = B.r;
     // The coupling force is the reaction of the fluid's velocity correction over this step: an
     // impulse F_c dt within the step, like the contact acceleration of the paper's Eq. 13-14
@@ -520,6 +529,45 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
           for (int a = 0; a < 3; ++a)
             for (int c = 0; c < 3; ++c)
               for (int i = 0; i < 2; ++i) ke[6 * (2 * a + i) + 2 * c + i] += c0 * rho * me[a][c];
+      }
+      if (iter_w) {
+        // Coupled iterations: the reaction F_c the coupler sent was computed from the
+        // velocity w it gave the fluid; about w it is F_c(v) ~ F_c - M_f (v - w) / dt, M_f the
+        // mass matrix of density rho_f (the fluid inside the body, which the forcing makes
+        // follow v). In the residual F_c enters with the weight s_d (2 on dofs with mass, 1 on
+        // massless ones, as above) and v_c^(n+1) = s_c (x_c^(n+1) - x_c^n) / dt - [mass] v_c^n,
+        // so
+        //   r_d -= s_d / dt sum_c M_f,dc (v_c - w_c),   K_dc += s_d s_c / dt^2 M_f,dc.
+        // The term vanishes when the step returns v^(n+1) = w (a converged iteration), and it
+        // gives a body without excess mass (rho_s = rho_f) the inertia rho_f it otherwise lacks
+        // within the step: a free neutrally buoyant body has a regular matrix.
+        double me[3][3];
+        element_mass(B.geo[e].area, lumped, me);
+        const double rf = m_model.settings.fluid_density;
+        double sw[6], dv[6];
+        for (int c = 0; c < 6; ++c) {
+          const int d = 2 * t[c / 2] + c % 2;
+          const bool mass = B.mass_row[d] > 0;
+          sw[c] = mass ? 2.0 : 1.0;
+          const double v = sw[c] * (B.u[d] - B.u_old[d]) / dt - (mass ? B.v_old[d] : 0.0);
+          dv[c] = v - (*iter_w)[d];
+        }
+        for (int a = 0; a < 3; ++a)
+          for (int i = 0; i < 2; ++i) {
+            double m = 0, mabs = 0;
+            for (int c = 0; c < 3; ++c) {
+              m += me[a][c] * dv[2 * c + i];
+              mabs += me[a][c] * std::abs(dv[2 * c + i]);
+            }
+            r[2 * t[a] + i] -= sw[2 * a + i] * rf / dt * m;
+            absm[2 * t[a] + i] += sw[2 * a + i] * rf / dt * mabs;
+          }
+        if (with_matrix)
+          for (int a = 0; a < 3; ++a)
+            for (int c = 0; c < 3; ++c)
+              for (int i = 0; i < 2; ++i)
+                ke[6 * (2 * a + i) + 2 * c + i] +=
+                    sw[2 * a + i] * sw[2 * c + i] * rf / (dt * dt) * me[a][c];
       }
       if (with_matrix && m_dirichlet_pending) {
         double dp[6];
@@ -888,7 +936,8 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
   return rep;
 }
 
-StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* external) {
+StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* external,
+                           const std::vector<std::vector<double>>* iteration_velocity) {
   if (!(dt > 0)) fsi::fail("solid: time step must be > 0, got {}", dt);
   if (m_bodies.empty()) {  // a scene without bodies: only the clock moves
     m_time += dt;
@@ -918,7 +967,18 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
   update_rigid(t1);
   prepare_prescribed(t1);
   m_contact_force_factor = 0.5;
-  StepReport rep = newton(4 / (dt * dt), dt, t1, external, when);
+  m_iteration_velocity =
+      m_model.settings.iteration_fluid_mass && m_model.settings.fluid_density > 0
+          ? iteration_velocity
+          : nullptr;
+  StepReport rep;
+  try {
+    rep = newton(4 / (dt * dt), dt, t1, external, when);
+  } catch (...) {
+    m_iteration_velocity = nullptr;
+    throw;
+  }
+  m_iteration_velocity = nullptr;
   // Newmark velocity from the positions, v^(n+1) = 2 (x^(n+1) - x^n) / dt - v^n (the trapezoidal
   // rule), and (M a)^(n+1) = F - Q: the acceleration without the contact part (Eq. 13-16).
   // Massless dofs (rho_s = rho_f) are quasi-static: v = (x^(n+1) - x^n) / dt, (M a) = 0.

@@ -70,7 +70,13 @@ class Solver {
   // added to gravity and the scene's loads at t + dt. Throws fsi::Error when Newton fails, an
   // element inverts (det F <= 0) or a value is not finite; the message names body, element or
   // node, step and time.
-  StepReport advance(double dt, const std::vector<std::vector<double>>* external = nullptr);
+  //
+  // Coupled iterations: iteration_velocity[b] (may be null or empty per body) is the velocity
+  // w at t + dt whose footprint the fluid's forcing used for `external`. With
+  // settings.iteration_fluid_mass the step then linearises the reaction about it (solver.cpp,
+  // assemble): a term that vanishes when the step returns v^(n+1) = w.
+  StepReport advance(double dt, const std::vector<std::vector<double>>* external = nullptr,
+                     const std::vector<std::vector<double>>* iteration_velocity = nullptr);
 
   // Coupled iterations: keep the current state / go back to a kept one (then advance() redoes
   // the step from it and gives bit for bit what it gave the first time with the same forces).
@@ -163,6 +169,7 @@ class Solver {
   ContactSet m_contact;
   double m_contact_force_factor = 1;  // physical contact force / multiplier (1/2 in Newmark)
   bool m_dirichlet_pending = false;   // a prescribed increment awaits the first Newton solve
+  const std::vector<std::vector<double>>* m_iteration_velocity = nullptr;  // during advance()
 };
 
 }  // namespace solid

@@ -69,8 +69,10 @@ TEST_CASE("every message survives a round trip") {
   CHECK(fo2.fs_u == fo.fs_u);
   CHECK(fo2.cfl == 0.3);
 
-  SolidInput si{{{1, 2, 3, 4}, {}}};
-  CHECK(round_trip(si).force == si.force);
+  SolidInput si{{{1, 2, 3, 4}, {}}, {{0.5, -0.5, 0, 1}, {}}};
+  const auto si2 = round_trip(si);
+  CHECK(si2.force == si.force);
+  CHECK(si2.velocity == si.velocity);
   SolidState ss{0.5, {{0, 0, 1, 0}}, {{0, 1, 0, 1}}};
   const auto ss2 = round_trip(ss);
   CHECK(ss2.x == ss.x);
