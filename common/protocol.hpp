@@ -216,8 +216,8 @@ struct SolidInput {  // coupler -> solid, every step
   // fibers' root loads as equivalent nodal forces. Empty for rigid bodies.
   std::vector<std::vector<double>> force;
   // Coupled iterations only (empty in the explicit step): per body, the nodal velocities at
-  // t^(n+1) whose footprint average u_s the fluid's forcing of this pass used (v^n at iteration
-  // 0, the coupler's estimate after). The reaction depends on them as dF/dv ~ -M_f/dt (M_f the
+  // t^(n+1) whose footprint average u_s the fluid's forcing of this pass used (the first
+  // estimate 2v^n - v^(n-1) at iteration 0, the coupler's accelerated estimate after). The reaction depends on them as dF/dv ~ -M_f/dt (M_f the
   // mass matrix of the fluid inside the body); a solid may use them to linearise it.
   std::vector<std::vector<double>> velocity;
   void pack(Writer& w) const;

@@ -544,20 +544,21 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
         double me[3][3];
         element_mass(B.geo[e].area, lumped, me);
         const double rf = m_model.settings.fluid_density;
-        double sw[6], dv[6];
+        double sw[6], dv[6], vabs[6];  // vabs: |v| + |w|, the scale of the terms that cancel
         for (int c = 0; c < 6; ++c) {
           const int d = 2 * t[c / 2] + c % 2;
           const bool mass = B.mass_row[d] > 0;
           sw[c] = mass ? 2.0 : 1.0;
           const double v = sw[c] * (B.u[d] - B.u_old[d]) / dt - (mass ? B.v_old[d] : 0.0);
           dv[c] = v - (*iter_w)[d];
+          vabs[c] = std::abs(v) + std::abs((*iter_w)[d]);
         }
         for (int a = 0; a < 3; ++a)
           for (int i = 0; i < 2; ++i) {
             double m = 0, mabs = 0;
             for (int c = 0; c < 3; ++c) {
               m += me[a][c] * dv[2 * c + i];
-              mabs += me[a][c] * std::abs(dv[2 * c + i]);
+              mabs += me[a][c] * vabs[2 * c + i];
             }
             r[2 * t[a] + i] -= sw[2 * a + i] * rf / dt * m;
             absm[2 * t[a] + i] += sw[2 * a + i] * rf / dt * mabs;

@@ -198,4 +198,24 @@ TEST_CASE("coupled iterations: the linearised reaction vanishes at convergence a
     CHECK(fs.velocities(0)[d] == Approx(wf[0][d]).margin(1e-12));
     CHECK(fs.positions(0)[d] - x0[d] == Approx(1e-3 * wf[0][d]).margin(1e-15));
   }
+
+  // (c) The same free square, w = 0, under the nodal forces of a uniform body force g on the
+  // fluid's mass (F_a = rho_f g int N_a): the linearised reaction -M_f v / dt balances it by a
+  // rigid translation with v = g dt exactly (the sign of the term decides the direction).
+  Solver gs(free_model);
+  const Mesh& gm = gs.mesh(0);
+  const double g[2] = {2.0, -3.0}, dt = 1e-3;
+  std::vector<std::vector<double>> fg(1, std::vector<double>(n, 0.0));
+  for (const auto& t : gm.triangles) {
+    const double* a = &gm.x[2 * t[0]];
+    const double* b = &gm.x[2 * t[1]];
+    const double* c = &gm.x[2 * t[2]];
+    const double area = 0.5 * std::abs((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]));
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < 2; ++i) fg[0][2 * t[k] + i] += free_model.settings.fluid_density * g[i] * area / 3;
+  }
+  std::vector<std::vector<double>> w0(1, std::vector<double>(n, 0.0));
+  gs.advance(dt, &fg, &w0);
+  for (std::size_t d = 0; d < n; ++d)
+    CHECK(gs.velocities(0)[d] == Approx(g[d % 2] * dt).margin(1e-12));
 }
