@@ -21,12 +21,14 @@ SPEED_LIMIT = 50.0  # markers faster than this (in units of the flow's speed sca
 ITERATIONS = 5
 
 
-def glycocalyx(dt, spacing, kappa, t_end):
-    # Bending limit of a fiber step: ds^2 sqrt(rho' / (12 gamma)) (fiber/README.md).
-    ds = 0.125 / 62
-    limit = ds * ds * math.sqrt(0.1 / (12 * 1e-4))
-    sub = max(1, math.ceil(dt / (0.95 * limit)))
-    coupler = f"[coupler]\nkappa = {kappa:g}\n" if kappa else ""
+def substeps(dt, ds, density, bending):
+    """Fiber sub-steps that keep each one below 0.95 of the bending limit
+    ds^2 sqrt(rho' / (12 gamma)) (fiber/README.md)."""
+    return max(1, math.ceil(dt / (0.95 * ds * ds * math.sqrt(density / (12 * bending)))))
+
+
+def fluid_head(dt, t_end, cells, size, top):
+    """The scene's time, output and fluid tables (periodic in x, walls below and above)."""
     return f"""[scene]
 name = "stability"
 [time]
@@ -39,14 +41,20 @@ density = 1.0
 viscosity = 0.01
 diffusion = "implicit"
 [fluid.grid]
-cells = [128, 96]
-size = [1.0, 0.75]
+cells = [{cells[0]}, {cells[1]}]
+size = [{size[0]!r}, {size[1]!r}]
 [fluid.boundary]
 left = {{ type = "periodic" }}
 right = {{ type = "periodic" }}
 bottom = {{ type = "wall" }}
-top = {{ type = "wall", velocity = 1.0 }}
-[fluid.initial]
+top = {{ {top} }}
+"""
+
+
+def glycocalyx(dt, spacing, kappa, t_end):
+    sub = substeps(dt, 0.125 / 62, 0.1, 1e-4)
+    coupler = f"[coupler]\nkappa = {kappa:g}\n" if kappa else ""
+    return fluid_head(dt, t_end, (128, 96), (1.0, 0.75), 'type = "wall", velocity = 1.0') + f"""[fluid.initial]
 type = "uniform"
 velocity = [1.0, 0.0]
 [fluid.health]
@@ -72,29 +80,8 @@ kind = "clamped"
 
 
 def moving(dt, t_end):
-    ds = 0.25 / 16
-    limit = ds * ds * math.sqrt(0.5 / (12 * 0.01))
-    sub = max(1, math.ceil(dt / (0.95 * limit)))
-    return f"""[scene]
-name = "stability"
-[time]
-dt = {dt:.10g}
-t_end = {t_end:g}
-[output]
-interval = {t_end:g}
-[fluid]
-density = 1.0
-viscosity = 0.01
-diffusion = "implicit"
-[fluid.grid]
-cells = [64, 64]
-size = [1.0, 1.0]
-[fluid.boundary]
-left = {{ type = "periodic" }}
-right = {{ type = "periodic" }}
-bottom = {{ type = "wall" }}
-top = {{ type = "wall" }}
-[solid]
+    sub = substeps(dt, 0.25 / 16, 0.5, 0.01)
+    return fluid_head(dt, t_end, (64, 64), (1.0, 1.0), 'type = "wall"') + f"""[solid]
 [[solid.body]]
 name = "block"
 kind = "rigid"
