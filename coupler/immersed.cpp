@@ -70,26 +70,6 @@ EdgeIndex::EdgeIndex(const std::vector<double>& e) : m_e(&e) {
   if (m_even) m_inv = 1.0 / h;
 }
 
-// The largest k with e[k] <= c (strict: e[k] < c), −1 when there is none.
-template <bool strict>
-int EdgeIndex::locate(double c) const {
-  const std::vector<double>& e = *m_e;
-  const int n = static_cast<int>(e.size()) - 1;
-  auto below = [c](double edge) { return strict ? edge < c : edge <= c; };
-  if (!m_even)
-    return static_cast<int>(strict ? std::lower_bound(e.begin(), e.end(), c) - e.begin()
-                                   : std::upper_bound(e.begin(), e.end(), c) - e.begin()) -
-           1;
-  const double g = std::floor((c - e[0]) * m_inv);
-  int k = g < -1 ? -1 : (g > n ? n : static_cast<int>(g));
-  while (k >= 0 && !below(e[k])) --k;
-  while (k < n && below(e[k + 1])) ++k;
-  return k;
-}
-
-int EdgeIndex::last_at_or_below(double c) const { return locate<false>(c); }
-int EdgeIndex::last_below(double c) const { return locate<true>(c); }
-
 ImmersedSolid::ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshes& meshes)
     : m_meshes(meshes),
       m_ub(FaceBoxes::u_faces(grid)),
@@ -140,19 +120,21 @@ void ImmersedSolid::clip_body(const FaceBoxes& boxes, const EdgeIndex& ix, const
         const int j0 = std::max(boxes.j_lo, iy.last_at_or_below(y0));
         const int j1 = std::min(boxes.j_hi - 1, iy.last_below(y1));
         if (i0 > i1 || j0 > j1) continue;
+        // Barycentric coordinates of T as an affine map, set up once per triangle:
+        //   (N_1, N_2) = B (q − t_0),  B = [t_1 − t_0, t_2 − t_0]^{-1},  N_0 = 1 − N_1 − N_2.
+        const double e1x = t[1].x - t[0].x, e1y = t[1].y - t[0].y;
+        const double e2x = t[2].x - t[0].x, e2y = t[2].y - t[0].y;
+        const double inv = 1.0 / (e1x * e2y - e2x * e1y);
+        const double b11 = e2y * inv, b12 = -e2x * inv, b21 = -e1y * inv, b22 = e1x * inv;
         auto emit = [&](const Vec2* poly, int n, int i, int j) {
           if (n < 3) return;
           const PolygonMoments m = polygon_moments(poly, n);
           const double area = std::abs(m.area);
           if (area == 0) return;
-          double N[3];
-          barycentric(t, m.centroid, N);
-          for (int k = 0; k < 3; ++k) {
-            raw.face.push_back(i + boxes.ni * j);
-            raw.body.push_back(b);
-            raw.node.push_back(a[k]);
-            raw.weight.push_back(area * N[k]);
-          }
+          const double qx = m.centroid.x - t[0].x, qy = m.centroid.y - t[0].y;
+          const double n1 = b11 * qx + b12 * qy, n2 = b21 * qx + b22 * qy;
+          raw.push_back({i + boxes.ni * j, b, {a[0], a[1], a[2]},
+                         {area * (1.0 - n1 - n2), area * n1, area * n2}});
         };
         // Inside one box: the piece is the whole triangle.
         if (i0 == i1 && j0 == j1 && x0 >= boxes.ex[i0] && x1 <= boxes.ex[i0 + 1] &&
@@ -210,24 +192,24 @@ void ImmersedSolid::clip_body(const FaceBoxes& boxes, const EdgeIndex& ix, const
   }
 }
 
-// The touched faces (sorted) and each entry's slot among them; the area of each face.
-void ImmersedSolid::gather(const Raw& fixed, const Raw& moving, Pieces& p, Scratch& s) {
+// The touched faces (sorted) and each piece's slot among them; the area of each face.
+void ImmersedSolid::gather(const Raw& fixed, const Raw& moving, Faces& p, Scratch& s) {
   auto& slot = s.slot;
   p.fixed = &fixed;
   p.moving = &moving;
   p.face.clear();
   for (const Raw* r : {&fixed, &moving})
-    for (const std::int32_t f : r->face)
-      if (slot[f] < 0) slot[f] = 0, p.face.push_back(f);
+    for (const Piece& q : *r)
+      if (slot[q.face] < 0) slot[q.face] = 0, p.face.push_back(q.face);
   std::sort(p.face.begin(), p.face.end());
   const std::size_t nf = p.face.size();
   for (std::size_t k = 0; k < nf; ++k) slot[p.face[k]] = static_cast<std::int32_t>(k);
   p.area.assign(nf, 0.0);
   auto slots = [&](const Raw& r, std::vector<std::int32_t>& out) {
-    out.resize(r.face.size());
-    for (std::size_t e = 0; e < r.face.size(); ++e) {
-      out[e] = slot[r.face[e]];
-      p.area[out[e]] += r.weight[e];
+    out.resize(r.size());
+    for (std::size_t e = 0; e < r.size(); ++e) {
+      out[e] = slot[r[e].face];
+      p.area[out[e]] += r[e].w[0] + r[e].w[1] + r[e].w[2];
     }
   };
   slots(fixed, p.slot_fixed);
@@ -239,13 +221,16 @@ void ImmersedSolid::gather(const Raw& fixed, const Raw& moving, Pieces& p, Scrat
   }
 }
 
-void ImmersedSolid::fill(const FaceBoxes& boxes, const Pieces& p, const proto::SolidState& state,
+void ImmersedSolid::fill(const FaceBoxes& boxes, const Faces& p, const proto::SolidState& state,
                          int component, proto::FaceSolid& out) const {
   const std::size_t nf = p.face.size();
   p.sum.assign(nf, 0.0);
   for (const auto& [r, slot] : {std::pair{p.fixed, &p.slot_fixed}, std::pair{p.moving, &p.slot_moving}})
-    for (std::size_t e = 0; e < r->face.size(); ++e)
-      p.sum[(*slot)[e]] += r->weight[e] * state.v[r->body[e]][2 * r->node[e] + component];
+    for (std::size_t e = 0; e < r->size(); ++e) {
+      const Piece& q = (*r)[e];
+      const double* v = state.v[q.body].data() + component;
+      p.sum[(*slot)[e]] += q.w[0] * v[2 * q.node[0]] + q.w[1] * v[2 * q.node[1]] + q.w[2] * v[2 * q.node[2]];
+    }
   out.index = p.face;
   out.alpha.resize(nf);
   out.velocity.resize(nf);
@@ -264,7 +249,7 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
   // second thread while this one does the u-family. The other programs wait for this step's
   // messages meanwhile, so the second core is free.
   auto family = [&](const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy, Raw& fixed,
-                    Raw& raw, Pieces& p, Scratch& s, int c, proto::FaceSolid& out) {
+                    Raw& raw, Faces& p, Scratch& s, int c, proto::FaceSolid& out) {
     if (!m_fixed_done)
       for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
         if (bodies[b].kind == 1) clip_body(boxes, ix, iy, b, state.x[b], fixed);
@@ -298,10 +283,10 @@ void ImmersedSolid::reaction(const std::vector<double>& fs_u, const std::vector<
   const auto& bodies = m_meshes.bodies;
   force.resize(bodies.size());
   for (std::size_t b = 0; b < bodies.size(); ++b) force[b].assign(bodies[b].x_ref.size(), 0.0);
-  auto add = [&](const FaceBoxes& boxes, const Pieces& p, const std::vector<double>& fs, int c) {
+  auto add = [&](const FaceBoxes& boxes, const Faces& p, const std::vector<double>& fs, int c) {
     if (fs.size() != p.face.size())
       fsi::fail("protocol error: {} forcing values for {} solid faces", fs.size(), p.face.size());
-    // Per face, −f_s |V| / Σ|V ∩ T|; then each entry's share of it.
+    // Per face, −f_s |V| / Σ|V ∩ T|; then each piece's share of it.
     p.sum.resize(p.face.size());
     for (std::size_t k = 0; k < p.face.size(); ++k) {
       const int i = p.face[k] % boxes.ni, j = p.face[k] / boxes.ni;
@@ -309,8 +294,12 @@ void ImmersedSolid::reaction(const std::vector<double>& fs_u, const std::vector<
     }
     for (const auto& [r, slot] :
          {std::pair{p.fixed, &p.slot_fixed}, std::pair{p.moving, &p.slot_moving}})
-      for (std::size_t e = 0; e < r->face.size(); ++e)
-        force[r->body[e]][2 * r->node[e] + c] += p.sum[(*slot)[e]] * r->weight[e];
+      for (std::size_t e = 0; e < r->size(); ++e) {
+        const Piece& q = (*r)[e];
+        const double s = p.sum[(*slot)[e]];
+        double* f = force[q.body].data() + c;
+        for (int k = 0; k < 3; ++k) f[2 * q.node[k]] += s * q.w[k];
+      }
   };
   add(m_ub, m_u, fs_u, 0);
   add(m_vb, m_v, fs_v, 1);

@@ -3,6 +3,8 @@
 // exact nodal reaction of the fluid's forcing. Cost grows with the bodies' footprint, not the grid.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -36,8 +38,8 @@ struct FaceBoxes {
 class EdgeIndex {
  public:
   explicit EdgeIndex(const std::vector<double>& e);
-  int last_at_or_below(double c) const;
-  int last_below(double c) const;
+  int last_at_or_below(double c) const { return locate<false>(c); }
+  int last_below(double c) const { return locate<true>(c); }
 
  private:
   template <bool strict>
@@ -46,6 +48,23 @@ class EdgeIndex {
   bool m_even = false;
   double m_inv = 0;
 };
+
+// The largest k with e[k] <= c (strict: e[k] < c), −1 when there is none.
+template <bool strict>
+inline int EdgeIndex::locate(double c) const {
+  const std::vector<double>& e = *m_e;
+  const int n = static_cast<int>(e.size()) - 1;
+  auto below = [c](double edge) { return strict ? edge < c : edge <= c; };
+  if (!m_even)
+    return static_cast<int>(strict ? std::lower_bound(e.begin(), e.end(), c) - e.begin()
+                                   : std::upper_bound(e.begin(), e.end(), c) - e.begin()) -
+           1;
+  const double g = std::floor((c - e[0]) * m_inv);
+  int k = g < -1 ? -1 : (g > n ? n : static_cast<int>(g));
+  while (k >= 0 && !below(e[k])) --k;
+  while (k < n && below(e[k + 1])) ++k;
+  return k;
+}
 
 class ImmersedSolid {
  public:
@@ -77,15 +96,18 @@ class ImmersedSolid {
   double area_v() const { return m_v.total_area; }
 
  private:
-  struct Raw {  // entries (face, body, node, ∫_{V∩T} N_node dA) in clipping order
-    std::vector<std::int32_t> face, body, node;
-    std::vector<double> weight;
-    void clear() { face.clear(), body.clear(), node.clear(), weight.clear(); }
+  // One piece V ∩ T: its face, the body and nodes of T, and ∫_{V∩T} N_a dA for the three nodes
+  // (their sum is |V ∩ T|). A family's pieces are kept in clipping order.
+  struct Piece {
+    std::int32_t face, body;
+    std::int32_t node[3];
+    double w[3];
   };
-  // The touched faces of one family (sorted by index) and, for the entries of the fixed and the
-  // moving bodies' Raw lists, the slot of each entry's face: per-face sums are then one pass over
-  // the entries into slot-indexed arrays, with no reordering of the entries.
-  struct Pieces {
+  using Raw = std::vector<Piece>;
+  // The touched faces of one family (sorted by index) and, for the pieces of the fixed and the
+  // moving bodies' lists, the slot of each piece's face: per-face sums are then one pass over
+  // the pieces into slot-indexed arrays, with no reordering of the pieces.
+  struct Faces {
     std::vector<std::int32_t> face;
     std::vector<double> area;            // Σ |V ∩ T| of the face
     std::vector<std::int32_t> slot_fixed, slot_moving;
@@ -99,8 +121,8 @@ class ImmersedSolid {
   struct Scratch {  // per face of a family: -1, or its slot while gather() runs
     std::vector<std::int32_t> slot;
   };
-  void gather(const Raw& fixed, const Raw& moving, Pieces& p, Scratch& s);
-  void fill(const FaceBoxes& boxes, const Pieces& p, const proto::SolidState& state, int component,
+  void gather(const Raw& fixed, const Raw& moving, Faces& p, Scratch& s);
+  void fill(const FaceBoxes& boxes, const Faces& p, const proto::SolidState& state, int component,
             proto::FaceSolid& out) const;
 
   const proto::BodyMeshes& m_meshes;
@@ -108,7 +130,7 @@ class ImmersedSolid {
   EdgeIndex m_ux, m_uy, m_vx, m_vy;  // box lookup of each family
   Raw m_fixed_u, m_fixed_v, m_raw_u, m_raw_v;  // rigid fixed bodies' pieces, clipped once
   bool m_fixed_done = false;
-  Pieces m_u, m_v;
+  Faces m_u, m_v;
   Scratch m_scratch_u, m_scratch_v;
   bool m_threads = false;  // the two families on two threads (more than one core)
 };
