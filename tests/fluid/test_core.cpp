@@ -2,7 +2,9 @@
 // exact plane Poiseuille flow on the MAC grid.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -245,4 +247,45 @@ TEST_CASE("two runs are bit-identical", "[fluid][determinism]") {
   const auto a = run(), b = run();
   CHECK(a.first == b.first);
   CHECK(a.second == b.second);
+}
+
+// The CFL number against a loop written from its definition, on a random field and on one whose
+// largest value sits in a known cell; a NaN or an infinity anywhere makes it NaN.
+TEST_CASE("CFL number: value, cell and non-finite fields", "[fluid][health]") {
+  Config c = channel(37, 23, BcType::periodic, BcType::wall);
+  c.y.tanh_beta = 1.2;  // uneven rows: the row width enters
+  Solver s(c, 1e-4);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> d(-1, 1);
+  const Grid& g = s.grid();
+  for (int j = 0; j < g.ny(); ++j)
+    for (int i = 0; i <= g.nx(); ++i) s.u()(i, j) = d(rng);
+  for (int j = 0; j <= g.ny(); ++j)
+    for (int i = 0; i < g.nx(); ++i) s.v()(i, j) = d(rng);
+  auto reference = [&] {
+    Extremum e;
+    for (int j = 0; j < g.ny(); ++j)
+      for (int i = 0; i < g.nx(); ++i) {
+        const double v = std::max(std::abs(s.u()(i, j)), std::abs(s.u()(i + 1, j))) * g.x().wi()[i] +
+                         std::max(std::abs(s.v()(i, j)), std::abs(s.v()(i, j + 1))) * g.y().wi()[j];
+        if (v > e.value) e = {v, i, j, 0, 0};
+      }
+    e.value *= 0.5;
+    return e;
+  };
+  const Extremum r = reference(), e = cfl(s, 0.5);
+  CHECK(e.value == r.value);
+  CHECK(e.i == r.i);
+  CHECK(e.j == r.j);
+  s.u()(17, 9) = -40;  // the largest, in cell (16, 9) (face 17 is its right face) and (17, 9)
+  const Extremum e2 = cfl(s, 0.5);
+  CHECK(e2.value == reference().value);
+  CHECK(e2.j == 9);
+  CHECK((e2.i == 16 || e2.i == 17));
+  CHECK(e2.x == g.x().centre(e2.i));
+  CHECK(e2.y == g.y().centre(9));
+  s.v()(3, 20) = std::numeric_limits<double>::infinity();
+  CHECK(std::isnan(cfl(s, 0.5).value));
+  s.v()(3, 20) = std::numeric_limits<double>::quiet_NaN();
+  CHECK(std::isnan(cfl(s, 0.5).value));
 }
