@@ -106,10 +106,10 @@ void Text::pack(Writer& w) const { w.put(text); }
 void Text::unpack(Reader& r) { r.get(text); }
 
 void StepBegin::pack(Writer& w) const {
-  w.put(step), w.put(time), w.put(dt), w.put(action), w.put(iteration);
+  w.put(step), w.put(time), w.put(dt), w.put(action), w.put(iteration), w.put(may_repeat);
 }
 void StepBegin::unpack(Reader& r) {
-  r.get(step), r.get(time), r.get(dt), r.get(action), r.get(iteration);
+  r.get(step), r.get(time), r.get(dt), r.get(action), r.get(iteration), r.get(may_repeat);
 }
 
 void FluidInput::pack(Writer& w) const {

@@ -17,7 +17,7 @@
 namespace fsi::proto {
 
 // Bump on any change of a message's layout or of the message order.
-inline constexpr std::int32_t kVersion = 3;
+inline constexpr std::int32_t kVersion = 4;
 inline constexpr std::uint32_t kMagic = 0x4d495346;  // "FSIM"
 
 enum class Tag : std::int32_t {
@@ -172,6 +172,9 @@ struct StepBegin {  // coupler -> each solver, every step
   // redo the same step from its start with new input (sub-iteration k). A step is committed
   // (the solver may write its output) when step n + 1 begins with iteration 0, or at stop.
   std::int32_t iteration = 0;
+  // 1 when coupled iterations are on, so that this step may be redone: a solver keeps what a
+  // redo needs only then (the fluid's predictor fields, three copies of the grid per step).
+  std::int32_t may_repeat = 0;
   void pack(Writer& w) const;
   void unpack(Reader& r);
 };

@@ -370,7 +370,8 @@ void Coupler::exchange(Role r, const In& in, Out& out, long n) {
 // With max = 1 this is the explicit staggered step, every operation in the same order.
 void Coupler::step(long n) {
   const auto& s = m_rt.settings();
-  proto::StepBegin sb{n, fsi::step_time(s, n), s.dt, proto::Action::step, 0};
+  const bool iterate = m_accel && m_immersed;
+  proto::StepBegin sb{n, fsi::step_time(s, n), s.dt, proto::Action::step, 0, iterate ? 1 : 0};
   for (Role r : {Role::fluid, Role::solid, Role::fiber})
     if (has(r)) m_rt.link(r).send(sb, n);
   m_rt.check_fault(n);
@@ -380,7 +381,6 @@ void Coupler::step(long n) {
   // explicit step takes v^n. Iterations start from the linear extrapolation 2 v^n - v^(n-1)
   // (v^n on the first step): an O(dt^2) guess instead of O(dt) for smooth motion, so fewer
   // iterations; the converged step does not depend on it.
-  const bool iterate = m_accel && m_immersed;
   const proto::SolidState* footprint = &m_start;
   if (iterate) {
     m_guess = m_start;

@@ -68,10 +68,12 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
   c.fiber_v_force = in.force_v.force;
   c.sample_u_index = in.sample_u;
   c.sample_v_index = in.sample_v;
-  if (s.iteration == 0)
+  if (s.iteration == 0) {
+    m_solver->set_keep_for_redo(s.may_repeat != 0);
     m_solver->step(s.dt, c, m_out);
-  else
+  } else {
     m_solver->redo_step(s.dt, c, m_out);
+  }
   out.fs_u = m_out.solid_u_force;
   out.fs_v = m_out.solid_v_force;
   out.u_sample = m_out.sample_u;

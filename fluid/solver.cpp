@@ -189,9 +189,12 @@ void Solver::step(double dt, const CouplingIn& in, CouplingOut& out) {
     predictor(dt, m_t + 0.5 * dt, &in);
   }
   // Kept for coupled iterations, which redo the rest of the step from here.
-  m_u_pred = m_u;
-  m_v_pred = m_v;
-  m_p_start = m_p;
+  m_can_redo = m_keep_for_redo;
+  if (m_can_redo) {
+    m_u_pred = m_u;
+    m_v_pred = m_v;
+    m_p_start = m_p;
+  }
   m_t_start = m_t;
   m_dt_prev_start = m_dt_prev;
   m_time.predictor += since(t0);
@@ -200,8 +203,8 @@ void Solver::step(double dt, const CouplingIn& in, CouplingOut& out) {
 }
 
 void Solver::redo_step(double dt, const CouplingIn& in, CouplingOut& out) {
-  if (m_step == 0 || dt != m_dt_prev)
-    throw std::invalid_argument("fluid::Solver::redo_step: no step of this dt to redo");
+  if (m_step == 0 || dt != m_dt_prev || !m_can_redo)
+    throw std::invalid_argument("fluid::Solver::redo_step: no step of this dt kept for a redo");
   // Back to the end of the predictor: u~, p^n, the explicit terms in their step-n slots.
   m_u = m_u_pred;
   m_v = m_v_pred;

@@ -72,9 +72,12 @@ class Solver {
   void step(double dt);
   void step(double dt, const CouplingIn& in, CouplingOut& out);
   // Coupled iterations: the step just taken again from its predictor u~ and p^n (kept by
-  // step()), with new solid input: immersed forcing, projection, samples. The fibers' force
-  // and the predictor are not recomputed (in.fiber_* is ignored). dt must be that of the step.
+  // step() while set_keep_for_redo(true), the default), with new solid input: immersed forcing,
+  // projection, samples. The fibers' force and the predictor are not recomputed (in.fiber_* is
+  // ignored). dt must be that of the step.
   void redo_step(double dt, const CouplingIn& in, CouplingOut& out);
+  // Whether step() keeps u~, v~ and p^n for a redo (three copies of the grid each step).
+  void set_keep_for_redo(bool keep) { m_keep_for_redo = keep; }
 
   // Fields. u: (nx+1) x ny, v: nx x (ny+1), p: nx x ny, with ghosts (Field). After set-up of
   // u and v by hand, call project_initial().
@@ -123,6 +126,8 @@ class Solver {
   // The last step's predictor u~ and p^n, and its t^n and dt' (for redo_step).
   Field m_u_pred, m_v_pred, m_p_start;
   double m_t_start = 0, m_dt_prev_start = 0;
+  bool m_keep_for_redo = true;
+  bool m_can_redo = false;  // the last step() kept its predictor
   std::unique_ptr<FastSolver> m_poisson, m_helm_u, m_helm_v;
   Timings m_time;
 };

@@ -47,10 +47,11 @@ TEST_CASE("every message survives a round trip") {
   Text t{Tag::final_report, "{\"a\": 1}"};
   CHECK(round_trip(t).text == t.text);
 
-  StepBegin sb{41, 0.041, 1e-3, Action::stop, 3};
+  StepBegin sb{41, 0.041, 1e-3, Action::stop, 3, 1};
   const auto sb2 = round_trip(sb);
   CHECK(sb2.step == 41);
   CHECK(sb2.iteration == 3);
+  CHECK(sb2.may_repeat == 1);
   CHECK(sb2.action == Action::stop);
 
   FluidInput fi;
