@@ -4,6 +4,7 @@
 #include "progress.hpp"
 #include "summary.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
 
@@ -22,6 +23,14 @@ void write_summary(const Runtime& rt, const nlohmann::json& summary) {
 }
 
 namespace {
+
+// Adds the wall time of f() to `seconds`.
+template <class F>
+void timed(double& seconds, F&& f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  f();
+  seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
 nlohmann::json base_summary(const Runtime& rt, long steps) {
   nlohmann::json j;
@@ -66,6 +75,9 @@ void follow(Runtime& rt, Port& port, Advance advance) {
   const auto& s = rt.settings();
   port.output(0, 0.0, is_output_step(s, 0));
   long steps = 0, repeats = 0;
+  // Wall time inside the port's step (its whole computation between receiving its input and
+  // sending its answer): the coupler's time for this solver's phase minus this is the messages'.
+  double port_seconds = 0;
   bool pending = false;  // step `steps` - 1 is done but not yet committed
   double t_done = 0;
   for (;;) {
@@ -83,13 +95,14 @@ void follow(Runtime& rt, Port& port, Advance advance) {
            sb.step, sb.iteration, steps - 1);
     if (sb.iteration == 0) rt.check_fault(sb.step);
     else ++repeats;
-    advance(sb);
+    advance(sb, port_seconds);
     steps = sb.step + 1;
     t_done = sb.time + sb.dt;
     pending = true;
   }
   nlohmann::json j = port.report();
   j["wall_time"] = rt.wall_seconds();
+  j["port_seconds"] = port_seconds;
   j["steps"] = steps;
   if (repeats > 0) j["repeated_steps"] = repeats;
   j["bytes_sent"] = c.bytes_sent();
@@ -102,13 +115,15 @@ void follow(Runtime& rt, Port& port, Advance advance) {
 template <class Port, class In, class State>
 void follow_state(Runtime& rt, Port& port, In& in, State& st, bool can_iterate) {
   Link& c = rt.coupler_link();
-  follow(rt, port, [&](const proto::StepBegin& sb) {
+  follow(rt, port, [&](const proto::StepBegin& sb, double& seconds) {
     if (sb.iteration > 0 && !can_iterate)
       fail("protocol error: the coupler asked the {} to repeat step {}, which it cannot",
            rt.name(), sb.step);
     c.recv(in);
-    port.advance(sb, in);
-    port.state(st);
+    timed(seconds, [&] {
+      port.advance(sb, in);
+      port.state(st);
+    });
     c.send(st, sb.step);
   });
 }
@@ -124,11 +139,11 @@ void serve(Runtime& rt, FluidPort& port) {
   proto::GridInfo grid = port.grid_info();
   grid.can_iterate = port.can_iterate();
   rt.coupler_link().send(grid);
-  follow(rt, port, [&](const proto::StepBegin& sb) {
+  follow(rt, port, [&](const proto::StepBegin& sb, double& seconds) {
     if (sb.iteration > 0 && !port.can_iterate())
       fail("protocol error: the coupler asked the fluid to repeat step {}, which it cannot", sb.step);
     rt.coupler_link().recv(in);
-    port.advance(sb, in, out);
+    timed(seconds, [&] { port.advance(sb, in, out); });
     rt.coupler_link().send(out, sb.step);
   });
 }
