@@ -4,7 +4,6 @@
 #include <sys/prctl.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -31,37 +30,27 @@ struct Announce {
   std::uint64_t options_hash;  // the output options: every program must be given the same
 };
 
-// Waiting without spinning the core: test, yield 20 times, then sleep between tests. A waiting
-// program must leave the cores to the one that computes (four programs share two cores here), yet
-// pick its message up soon after it arrives. The pause follows the wait's expected length (per
-// link, direction and tag: the last waits' average, since each step repeats the same pattern):
-// a quarter of the time still expected, at most kMaxSleepUs (a long wait wakes at most 1/kMaxSleepUs
-// times per second, a few µs of CPU each) and at least kMinSleepUs near the expected arrival;
-// past it, the pause grows again by a quarter of the delay. Measured on 2 cores, four programs:
-// a fixed 50 µs cap made the empty protocol step faster (133-218 µs against 270-440 µs) but the
-// default coupled scene slower (1.6-1.7 s against 0.9-1.1 s for its 1000 steps), since the waiting
-// programs then take the cores from the one that computes; the pause that follows the expected
-// arrival wakes about as often as the fixed 200 µs cap and picks up near the arrival.
-constexpr double kMaxSleepUs = 200, kMinSleepUs = 10;
+// Wait for a request without spinning the core: test, yield, then sleep with a growing interval,
+// at most kMaxSleepUs: a message is picked up within that of its arrival, and a waiting program
+// wakes at most 1/kMaxSleepUs times per second (a few µs of CPU each). Measured on 2 cores, four
+// programs: a 50 µs cap made the empty protocol step faster (133-218 µs against 270-440 µs) but
+// the default coupled scene slower (1.6-1.7 s against 0.9-1.1 s for its 1000 steps), since the
+// waiting programs then take the cores from the one that computes.
+constexpr int kMaxSleepUs = 200;
 
-template <class Test>
-void wait_until(double& expected_us, Test&& done) {
-  if (done()) return;
-  const auto t0 = std::chrono::steady_clock::now();
-  double elapsed = 0;
-  for (int k = 0;; ++k) {
-    if (k < 20) {
-      std::this_thread::yield();
-    } else {
-      const double left = expected_us - elapsed;
-      const double pause = left > 0 ? 0.25 * left : kMinSleepUs - 0.25 * left;
-      std::this_thread::sleep_for(std::chrono::duration<double, std::micro>(
-          std::clamp(pause, kMinSleepUs, kMaxSleepUs)));
-    }
-    elapsed = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
-    if (done()) break;
+// The k-th pause of a wait: 20 yields, then sleeps of 5, 10, ... up to kMaxSleepUs µs.
+void back_off(int k) {
+  if (k < 20) std::this_thread::yield();
+  else std::this_thread::sleep_for(std::chrono::microseconds(std::min(kMaxSleepUs, 5 * (k - 19))));
+}
+
+void wait_politely(MPI_Request& req) {
+  int done = 0;
+  MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+  for (int k = 0; !done; ++k) {
+    back_off(k);
+    MPI_Test(&req, &done, MPI_STATUS_IGNORE);
   }
-  expected_us = expected_us > 0 ? 0.75 * expected_us + 0.25 * elapsed : elapsed;
 }
 
 }  // namespace
@@ -179,11 +168,7 @@ void Link::send_bytes(const std::vector<std::byte>& bytes, proto::Tag tag) {
   MPI_Request req;
   MPI_Isend(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, 0, static_cast<int>(tag), m_comm,
             &req);
-  wait_until(m_send_us[slot(tag)], [&] {
-    int done = 0;
-    MPI_Test(&req, &done, MPI_STATUS_IGNORE);
-    return done != 0;
-  });
+  wait_politely(req);
   m_sent += bytes.size();
 }
 
@@ -191,10 +176,11 @@ std::vector<std::byte> Link::recv_bytes(proto::Tag expected) {
   int flag = 0;
   MPI_Message msg;
   MPI_Status status;
-  wait_until(m_recv_us[slot(expected)], [&] {
+  MPI_Improbe(0, MPI_ANY_TAG, m_comm, &flag, &msg, &status);
+  for (int k = 0; !flag; ++k) {
+    back_off(k);
     MPI_Improbe(0, MPI_ANY_TAG, m_comm, &flag, &msg, &status);
-    return flag != 0;
-  });
+  }
   if (status.MPI_TAG != static_cast<int>(expected))
     fail("protocol error: expected message '{}' from {}, got '{}'", proto::tag_name(expected),
          role_name(m_peer), proto::tag_name(static_cast<proto::Tag>(status.MPI_TAG)));

@@ -82,9 +82,6 @@ class Link {
   std::uint64_t bytes_received() const { return m_received; }
 
  private:
-  // Expected length (µs) of a wait to send or receive a message of each tag (runtime.cpp).
-  static std::size_t slot(proto::Tag t) { return static_cast<std::size_t>(t) % 32; }
-  std::array<double, 32> m_send_us{}, m_recv_us{};
   MPI_Comm m_comm;
   Role m_peer;
   std::uint64_t m_sent = 0, m_received = 0;
