@@ -77,7 +77,8 @@ void follow(Runtime& rt, Port& port, Advance advance) {
   long steps = 0, repeats = 0;
   // Wall time inside the port's step (its whole computation between receiving its input and
   // sending its answer): the coupler's time for this solver's phase minus this is the messages'.
-  double port_seconds = 0;
+  // And the work done ahead of the input (begin, prepare_next), outside that phase.
+  double port_seconds = 0, ahead_seconds = 0;
   bool pending = false;  // step `steps` - 1 is done but not yet committed
   double t_done = 0;
   for (;;) {
@@ -93,9 +94,15 @@ void follow(Runtime& rt, Port& port, Advance advance) {
     if (sb.step != expected || sb.iteration < 0 || (sb.iteration > 0 && !pending))
       fail("protocol error: the coupler began step {} iteration {} after step {} was done",
            sb.step, sb.iteration, steps - 1);
-    if (sb.iteration == 0) rt.check_fault(sb.step);
-    else ++repeats;
+    if (sb.iteration == 0) {
+      rt.check_fault(sb.step);
+      timed(ahead_seconds, [&] { port.begin(sb); });
+    } else {
+      ++repeats;
+    }
     advance(sb, port_seconds);
+    if (sb.may_repeat == 0 && sb.step + 1 < s.steps)
+      timed(ahead_seconds, [&] { port.prepare_next(sb); });
     steps = sb.step + 1;
     t_done = sb.time + sb.dt;
     pending = true;
@@ -103,6 +110,7 @@ void follow(Runtime& rt, Port& port, Advance advance) {
   nlohmann::json j = port.report();
   j["wall_time"] = rt.wall_seconds();
   j["port_seconds"] = port_seconds;
+  j["ahead_seconds"] = ahead_seconds;
   j["steps"] = steps;
   if (repeats > 0) j["repeated_steps"] = repeats;
   j["bytes_sent"] = c.bytes_sent();

@@ -23,6 +23,14 @@ class SolverPort {
   virtual std::string status() const { return {}; }
   // This solver's part of summary.json (phases, iterations, metrics).
   virtual nlohmann::json report() const { return nlohmann::json::object(); }
+  // Work ahead of the input, done while this solver would otherwise wait for it (the coupler is
+  // meanwhile running the other solvers or its own transfers); advance() must give the same
+  // result with or without it. prepare_next(): after the answer to step `done` was sent, when
+  // that step cannot be repeated (done.may_repeat == 0) and another follows (the previous step is
+  // not yet committed: its output is still to be written). begin(): on receiving step_begin for
+  // a new step (iteration 0), after the previous step's output, before its input.
+  virtual void prepare_next(const proto::StepBegin& done) { (void)done; }
+  virtual void begin(const proto::StepBegin& s) { (void)s; }
 };
 
 // Coupled iterations (common/PROTOCOL.md, "Coupled iterations"): a fluid or solid port that

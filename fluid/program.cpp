@@ -53,6 +53,14 @@ fsi::proto::GridInfo FluidProgram::grid_info() const {
   return gi;
 }
 
+// The step's first part (explicit terms, boundary values, the predictor) needs no coupling input,
+// except the fibers' force inside a Crank-Nicolson solve: then the whole step waits for it.
+void FluidProgram::begin(const fsi::proto::StepBegin& s) {
+  if (m_cfg.implicit && m_rt.roles()[fsi::Role::fiber]) return;
+  m_solver->begin_step(s.dt);
+  m_begun = true;
+}
+
 void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::FluidInput& in,
                            fsi::proto::FluidOutput& out) {
   CouplingIn c;
@@ -70,7 +78,9 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
   c.sample_v_index = in.sample_v;
   if (s.iteration == 0) {
     m_solver->set_keep_for_redo(s.may_repeat != 0);
-    m_solver->step(s.dt, c, m_out);
+    if (m_begun) m_solver->end_step(s.dt, c, m_out);
+    else m_solver->step(s.dt, c, m_out);
+    m_begun = false;
   } else {
     m_solver->redo_step(s.dt, c, m_out);
   }

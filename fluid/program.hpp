@@ -20,6 +20,8 @@ class FluidProgram : public fsi::FluidPort {
   void advance(const fsi::proto::StepBegin& s, const fsi::proto::FluidInput& in,
                fsi::proto::FluidOutput& out) override;
   bool can_iterate() const override { return true; }
+  void prepare_next(const fsi::proto::StepBegin&) override { m_solver->prepare_next_step(); }
+  void begin(const fsi::proto::StepBegin& s) override;
   void output(long step, double t, bool fields) override;
   std::string status() const override;
   nlohmann::json report() const override;
@@ -37,6 +39,7 @@ class FluidProgram : public fsi::FluidPort {
   std::optional<fsi::ProbeCsv> m_probes;
   std::vector<double> m_row, m_w1, m_w2;
   CouplingOut m_out;
+  bool m_begun = false;  // begin() took the step's first part
   double m_cfl = 0, m_div = 0, m_div_first = -1;
   double m_energy = 0;  // kinetic energy, refreshed with the divergence every health.every steps
   long m_written_step = -1;

@@ -165,13 +165,41 @@ void Solver::step(double dt) {
 }
 
 void Solver::step(double dt, const CouplingIn& in, CouplingOut& out) {
+  predict(dt, &in);
+  end_predicted(dt, in, out);
+}
+
+void Solver::begin_step(double dt) {
+  predict(dt, nullptr);
+  m_begun_dt = dt;
+}
+
+void Solver::end_step(double dt, const CouplingIn& in, CouplingOut& out) {
+  if (m_begun_dt != dt)
+    throw std::invalid_argument("fluid::Solver::end_step: no step of this dt begun");
+  const bool fibers = !in.fiber_u_index.empty() || !in.fiber_v_index.empty();
+  if (fibers && m_cfg.implicit)
+    throw std::invalid_argument("fluid::Solver::end_step: the Crank-Nicolson predictor takes the "
+                                "fibers' force inside its solve; take the step with step()");
+  if (fibers) {
+    const auto t0 = Clock::now();
+    add_fiber_force(dt, in);
+    m_time.predictor += since(t0);
+  }
+  end_predicted(dt, in, out);
+}
+
+// Explicit terms, boundary values at t^{n+1}, the predictor u~ (with the fibers' force when
+// `fibers` is given).
+void Solver::predict(double dt, const CouplingIn* fibers) {
   if (!(dt > 0)) throw std::invalid_argument("fluid::Solver::step: dt must be > 0");
   const double t_new = m_t + dt;
+  m_begun_dt = 0;
   auto t0 = Clock::now();
-  // Explicit terms at t^n (ghosts of u^n are filled).
+  // Explicit terms at t^n (ghosts of u^n are filled), unless prepare_next_step() did them.
   const bool imp = m_cfg.implicit;
-  momentum_terms(m_grid, m_sponge, m_u, m_v, imp ? 0.0 : m_nu, m_i0, m_j0, m_hu, m_hv,
-                 imp ? &m_lu : nullptr, imp ? &m_lv : nullptr);
+  if (m_prepared_step != m_step) explicit_terms();
+  m_prepared_step = -1;
   m_time.predictor += since(t0);
 
   // Boundary values at t^{n+1}; Crank-Nicolson also needs the ghosts with the new wall data.
@@ -184,10 +212,19 @@ void Solver::step(double dt, const CouplingIn& in, CouplingOut& out) {
   if (m_step == 0) m_dt_prev = dt;
   if (imp) {
     if (dt != m_dt_implicit) build_implicit(dt);
-    predictor_implicit(dt, m_t + 0.5 * dt, &in);
+    predictor_implicit(dt, m_t + 0.5 * dt, fibers);
   } else {
-    predictor(dt, m_t + 0.5 * dt, &in);
+    predictor(dt, m_t + 0.5 * dt);
+    if (fibers) add_fiber_force(dt, *fibers);
   }
+  m_time.predictor += since(t0);
+}
+
+// The predictor is complete (u~ with every force but the immersed solid's): keep it for a redo,
+// then the immersed forcing, the projection and the samples.
+void Solver::end_predicted(double dt, const CouplingIn& in, CouplingOut& out) {
+  const auto t0 = Clock::now();
+  m_begun_dt = 0;
   // Kept for coupled iterations, which redo the rest of the step from here.
   m_can_redo = m_keep_for_redo;
   if (m_can_redo) {
@@ -200,6 +237,20 @@ void Solver::step(double dt, const CouplingIn& in, CouplingOut& out) {
   m_time.predictor += since(t0);
   finish_step(dt, in, out);
   ++m_time.steps;
+}
+
+void Solver::explicit_terms() {
+  const bool imp = m_cfg.implicit;
+  momentum_terms(m_grid, m_sponge, m_u, m_v, imp ? 0.0 : m_nu, m_i0, m_j0, m_hu, m_hv,
+                 imp ? &m_lu : nullptr, imp ? &m_lv : nullptr);
+}
+
+void Solver::prepare_next_step() {
+  const auto t0 = Clock::now();
+  explicit_terms();
+  m_prepared_step = m_step;
+  m_can_redo = false;
+  m_time.predictor += since(t0);
 }
 
 void Solver::redo_step(double dt, const CouplingIn& in, CouplingOut& out) {
@@ -252,7 +303,8 @@ void Solver::finish_step(double dt, const CouplingIn& in, CouplingOut& out) {
 // Explicit predictor (AB2 for convection and diffusion, Euler on the first step):
 //   u~ = u^n + dt [ (1 + dt/(2 dt')) H^n - dt/(2 dt') H^{n-1} - G p^n / rho + f(t^{n+1/2}) / rho
 //                   + f_f / rho ],   H = -div(u u) + nu lap(u)
-void Solver::predictor(double dt, double t_half, const CouplingIn* in) {
+// without the fibers' f_f / rho, which add_fiber_force() adds on their faces.
+void Solver::predictor(double dt, double t_half) {
   const double c1 = m_step == 0 ? 1.0 : 1.0 + 0.5 * dt / m_dt_prev;
   const double c0 = m_step == 0 ? 0.0 : -0.5 * dt / m_dt_prev;
   const auto acc = body_acceleration(t_half);
@@ -280,17 +332,22 @@ void Solver::predictor(double dt, double t_half, const CouplingIn* in) {
       v[i] += dt * (c1 * h[i] + c0 * ho[i] + acc[1] - gy * (p[i] - ps[i]));
     }
   }
-  if (!in) return;
+}
+
+// u~ += dt f_f / rho on the fibers' faces (the explicit predictor's last term).
+void Solver::add_fiber_force(double dt, const CouplingIn& in) {
+  const double ri = 1.0 / m_cfg.density;
+  const int nx = m_grid.nx(), ny = m_grid.ny();
   const int nu = m_grid.nu();
-  for (std::size_t q = 0; q < in->fiber_u_index.size(); ++q) {
-    const auto idx = in->fiber_u_index[q];
+  for (std::size_t q = 0; q < in.fiber_u_index.size(); ++q) {
+    const auto idx = in.fiber_u_index[q];
     const int i = int(idx % nu), j = int(idx / nu);
-    if (i >= m_i0 && i < nx) m_u(i, j) += dt * ri * in->fiber_u_force[q];
+    if (i >= m_i0 && i < nx) m_u(i, j) += dt * ri * in.fiber_u_force[q];
   }
-  for (std::size_t q = 0; q < in->fiber_v_index.size(); ++q) {
-    const auto idx = in->fiber_v_index[q];
+  for (std::size_t q = 0; q < in.fiber_v_index.size(); ++q) {
+    const auto idx = in.fiber_v_index[q];
     const int i = int(idx % nx), j = int(idx / nx);
-    if (j >= m_j0 && j < ny) m_v(i, j) += dt * ri * in->fiber_v_force[q];
+    if (j >= m_j0 && j < ny) m_v(i, j) += dt * ri * in.fiber_v_force[q];
   }
 }
 

@@ -2,6 +2,7 @@
 // samples of the new velocity.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 #include "diagnostics.hpp"
@@ -141,4 +142,84 @@ TEST_CASE("redo of a step: same input, same fields; refused when not kept", "[fl
   s.set_keep_for_redo(false);
   s.step(dt, in, out);
   CHECK_THROWS_WITH(s.redo_step(dt, in, out2), Catch::Contains("kept for a redo"));
+}
+
+// Look-ahead: a step whose explicit terms prepare_next_step() computed beforehand gives the same
+// fields, bit for bit, as one that computes them itself (explicit and Crank-Nicolson diffusion,
+// with immersed forcing); the step before can no longer be redone.
+TEST_CASE("prepared explicit terms give the same step", "[fluid][coupling]") {
+  for (bool implicit : {false, true}) {
+    Config c = box(BcType::wall);
+    c.implicit = implicit;
+    const double dt = 1e-3;
+    Solver a(c, dt), b(c, dt);
+    const int nu = a.grid().nu();
+    std::vector<std::int32_t> iu;
+    std::vector<double> au, uu;
+    for (int i = 4; i < 8; ++i) iu.push_back(i + nu * 3), au.push_back(0.6), uu.push_back(0.3);
+    CouplingIn in;
+    in.solid_u_index = iu;
+    in.solid_u_alpha = au;
+    in.solid_u_velocity = uu;
+    CouplingOut oa, ob;
+    for (int n = 0; n < 4; ++n) {
+      a.step(dt, in, oa);
+      b.step(dt, in, ob);
+      b.prepare_next_step();
+    }
+    a.step(dt, in, oa);
+    b.step(dt, in, ob);
+    CHECK(a.u().a == b.u().a);
+    CHECK(a.v().a == b.v().a);
+    CHECK(a.p().a == b.p().a);
+    CHECK(oa.solid_u_force == ob.solid_u_force);
+    CHECK(*std::max_element(a.u().a.begin(), a.u().a.end()) > 0.01);  // the solid moved the fluid
+    b.prepare_next_step();
+    CHECK_THROWS_WITH(b.redo_step(dt, in, ob), Catch::Contains("kept for a redo"));
+  }
+}
+
+// A step begun before its input (begin_step, then end_step with the input) gives the step's
+// fields bit for bit, fibers' force included with explicit diffusion; Crank-Nicolson, which
+// solves with that force inside, refuses it.
+TEST_CASE("a step in two parts equals the step", "[fluid][coupling]") {
+  for (bool implicit : {false, true}) {
+    Config c = box(BcType::periodic);
+    c.implicit = implicit;
+    const double dt = 1e-3;
+    Solver a(c, dt), b(c, dt);
+    const int nu = a.grid().nu(), nx = a.grid().nx();
+    std::vector<std::int32_t> iu, fu, fv;
+    std::vector<double> au, uu, ffu, ffv;
+    for (int i = 4; i < 8; ++i) iu.push_back(i + nu * 3), au.push_back(0.6), uu.push_back(0.3);
+    for (int i = 9; i < 12; ++i) fu.push_back(i + nu * 5), ffu.push_back(40.0 * i);
+    fv.push_back(10 + nx * 6), ffv.push_back(-25.0);
+    CouplingIn in;
+    in.solid_u_index = iu;
+    in.solid_u_alpha = au;
+    in.solid_u_velocity = uu;
+    if (!implicit) {
+      in.fiber_u_index = fu;
+      in.fiber_u_force = ffu;
+      in.fiber_v_index = fv;
+      in.fiber_v_force = ffv;
+    }
+    CouplingOut oa, ob;
+    for (int n = 0; n < 4; ++n) {
+      a.step(dt, in, oa);
+      b.begin_step(dt);
+      b.end_step(dt, in, ob);
+    }
+    CHECK(a.u().a == b.u().a);
+    CHECK(a.v().a == b.v().a);
+    CHECK(a.p().a == b.p().a);
+    CHECK(oa.solid_u_force == ob.solid_u_force);
+    CHECK_THROWS_WITH(b.end_step(dt, in, ob), Catch::Contains("no step of this dt begun"));
+    if (implicit) {
+      in.fiber_u_index = fu;
+      in.fiber_u_force = ffu;
+      b.begin_step(dt);
+      CHECK_THROWS_WITH(b.end_step(dt, in, ob), Catch::Contains("Crank-Nicolson"));
+    }
+  }
 }
