@@ -149,18 +149,34 @@ void SolidProgram::state(fsi::proto::SolidState& st) const {
   }
 }
 
+// While the fluid steps, the solid factorises the first Newton matrix of its coming step (it
+// needs no forces); the step then reuses that factor. Not with coupled iterations, whose matrix
+// has the fluid's linearised reaction in it.
+void SolidProgram::begin(const fsi::proto::StepBegin& s) {
+  if (s.may_repeat == 0 && m_cfg.model.settings.analysis == Analysis::dynamic)
+    m_solver->factorize_ahead(s.dt);
+}
+
 void SolidProgram::advance(const fsi::proto::StepBegin& sb, const fsi::proto::SolidInput& in) {
   for (int b = 0; b < m_solver->num_bodies(); ++b) {
     m_external[b].clear();
     if (b < static_cast<int>(in.force.size()) && m_solver->kind(b) == BodyKind::elastic)
       m_external[b] = in.force[b];
   }
-  // Coupled iterations: iteration 0 keeps the state the step starts from, a repeat goes back
-  // to it. A solver without iterations (max = 1) pays one copy of its state per step.
-  if (sb.iteration == 0)
-    m_solver->save_state(m_start);
-  else
+  // Coupled iterations: iteration 0 keeps the state the step starts from when the step may be
+  // repeated (sb.may_repeat), a repeat goes back to it.
+  if (sb.iteration == 0) {
+    m_start_step = -1;
+    if (sb.may_repeat != 0) {
+      m_solver->save_state(m_start);
+      m_start_step = sb.step;
+    }
+  } else {
+    if (m_start_step != sb.step)
+      fsi::fail("protocol error: the coupler asked the solid to repeat step {}, whose start it "
+                "was not told to keep (may_repeat = 0)", sb.step);
     m_solver->restore_state(m_start);
+  }
   try {
     if (m_cfg.model.settings.analysis == Analysis::statics) {
       // A static analysis walks the load factor t / t_end over the scene's steps.
@@ -280,6 +296,7 @@ nlohmann::json SolidProgram::report() const {
   j["newton_iterations"] = m_newton_total;
   j["newton_iterations_max"] = m_newton_max;
   j["phases"] = {{"assembly", m_assembly}, {"factorization", m_factor}, {"solve", m_solve}};
+  j["factorizations_reused"] = s.factor_reuses();  // done ahead (begin) or unchanged matrix
   j["energy"] = {{"kinetic", s.kinetic_energy()},
                  {"strain", s.strain_energy()},
                  {"load_potential", s.load_potential()}};

@@ -25,6 +25,7 @@ class SolidProgram : public fsi::SolidPort {
   void state(fsi::proto::SolidState& s) const override;
   void advance(const fsi::proto::StepBegin& s, const fsi::proto::SolidInput& in) override;
   bool can_iterate() const override { return true; }
+  void begin(const fsi::proto::StepBegin& s) override;
   void output(long step, double t, bool fields) override;
   std::string status() const override;
   nlohmann::json report() const override;
@@ -45,6 +46,7 @@ class SolidProgram : public fsi::SolidPort {
   Modes m_modes;
   StepReport m_last;
   StepState m_start;  // the state the current step started from (coupled iterations)
+  long m_start_step = -1;  // the step m_start belongs to (-1: none kept)
   long m_newton_total = 0, m_newton_max = 0, m_steps = 0, m_repeats = 0, m_written_step = -1;
   double m_assembly = 0, m_factor = 0, m_solve = 0;
 };

@@ -332,6 +332,7 @@ void Solver::build_pattern() {
     }
   }
   m_residual.setZero(m_neq);
+  m_factored_valid = false;
   if (m_neq > 0) m_linear.analyze(m_matrix);
 }
 
@@ -616,8 +617,34 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
   return inverted;
 }
 
+// The factor is kept with the values it was computed from: an unchanged matrix (same pattern,
+// same values bit for bit; build_pattern() forgets the factor) is not factorised again.
+bool Solver::factorize_cached() {
+  const double* v = m_matrix.valuePtr();
+  const auto nnz = static_cast<std::size_t>(m_matrix.nonZeros());
+  if (m_factored_valid && m_factored.size() == nnz && std::equal(v, v + nnz, m_factored.begin())) {
+    ++m_factor_reuses;
+    return true;
+  }
+  m_factored_valid = false;
+  if (!m_linear.factorize(m_matrix)) return false;
+  m_factored.assign(v, v + nnz);
+  m_factored_valid = true;
+  return true;
+}
+
+void Solver::factorize_ahead(double dt) {
+  if (m_bodies.empty() || m_neq == 0 || m_model.settings.analysis != Analysis::dynamic) return;
+  for (auto& bp : m_bodies) {  // as advance() begins (the residual's inertia reads them)
+    bp->u_old = bp->u;
+    bp->v_old = bp->v;
+  }
+  assemble(4 / (dt * dt), dt, true, m_time + dt, nullptr);
+  if (m_residual.allFinite()) factorize_cached();
+}
+
 void Solver::factorize(const std::string& when) {
-  if (!m_linear.factorize(m_matrix))
+  if (!factorize_cached())
     fsi::fail(
         "solid: the stiffness matrix is singular at {}: a body is not held against rigid "
         "motion (no constraint, no mass, no contact) or an element has collapsed",

@@ -77,6 +77,13 @@ class Solver {
   // assemble): a term that vanishes when the step returns v^(n+1) = w.
   StepReport advance(double dt, const std::vector<std::vector<double>>* external = nullptr,
                      const std::vector<std::vector<double>>* iteration_velocity = nullptr);
+  // Look-ahead: the first Newton matrix of the next dynamic step of size dt (at the current
+  // state; forces enter only the residual), factorised now, while a coupled solid waits for its
+  // forces. The step finds the factor done: a factorisation is skipped when the matrix equals
+  // the last one factorised bit for bit (factorize()), so results do not change. A singular
+  // matrix is left for the step to report.
+  void factorize_ahead(double dt);
+  long factor_reuses() const { return m_factor_reuses; }
 
   // Coupled iterations: keep the current state / go back to a kept one (then advance() redoes
   // the step from it and gives bit for bit what it gave the first time with the same forces).
@@ -150,6 +157,7 @@ class Solver {
   StepReport newton(double c0, double dt, double load_factor,
                     const std::vector<std::vector<double>>* external, const std::string& when);
   void factorize(const std::string& when);
+  bool factorize_cached();
   [[noreturn]] void fail_health(const std::string& what, int body, int element,
                                 const std::string& when) const;
   void check_finite(const std::string& when) const;
@@ -166,6 +174,9 @@ class Solver {
   std::set<std::pair<int, int>> m_contact_entries;  // extra (row, col) entries contact needs
   Eigen::VectorXd m_residual;
   LinearSolver m_linear;
+  std::vector<double> m_factored;  // values of the matrix m_linear holds the factor of
+  bool m_factored_valid = false;
+  long m_factor_reuses = 0;
   ContactSet m_contact;
   double m_contact_force_factor = 1;  // physical contact force / multiplier (1/2 in Newmark)
   bool m_dirichlet_pending = false;   // a prescribed increment awaits the first Newton solve
