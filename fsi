@@ -253,6 +253,9 @@ print("  solid's step_begin after the footprint (its factorisation no longer bes
       " -1 ms | 17.2-18.4 ms; all together 24.7-27.4 -> 17.3-18.8 ms (x 0.69)")
 print("  waiting paced by the expected arrival instead of a fixed 200 us cap | faster pick-up |"
       " none measurable (messages 1.0-1.4 fixed, 1.4-1.6 ms paced): not kept")
+print("  work ahead on a thread of its own at nice 19 (so a waking coupler gets a core at once) |"
+      " -1 ms messages | worse: 18.2-22.7 ms (messages 2.1-3.3: the fluid's predictor starved beside"
+      " the clipping, with one footprint thread too): not kept")
 PY
 }
 
