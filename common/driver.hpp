@@ -44,7 +44,9 @@ class FluidPort : public SolverPort {
   // One fluid step t^n -> t^n + dt with the coupler's sparse input; fills `out` (f_s on the
   // solid faces, samples of u^(n+1), diagnostics). With s.iteration > 0: the same step again
   // from the same predictor u~ (and p^n), with new solid velocities: redo the immersed forcing
-  // and the projection only (the fibers' force is the same as in iteration 0).
+  // and the projection only (the fibers' force is the same as in iteration 0). Only a step
+  // whose iteration 0 came with s.may_repeat = 1 is ever repeated: a port keeps what a redo
+  // needs only then.
   virtual void advance(const proto::StepBegin& s, const proto::FluidInput& in,
                        proto::FluidOutput& out) = 0;
   virtual bool can_iterate() const { return false; }

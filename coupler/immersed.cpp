@@ -246,8 +246,8 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
   if (state.x.size() != bodies.size() || state.v.size() != bodies.size())
     fsi::fail("solid state has {} bodies, the meshes {}", state.x.size(), bodies.size());
   // The two families are independent (own boxes, pieces and scratch): the v-family runs on a
-  // second thread while this one does the u-family. The other programs wait for this step's
-  // messages meanwhile, so the second core is free.
+  // second thread while this one does the u-family. The solid waits meanwhile; the fluid runs its
+  // predictor ahead of its input (one core's worth of work).
   auto family = [&](const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy, Raw& fixed,
                     Raw& raw, Faces& p, Scratch& s, int c, proto::FaceSolid& out) {
     if (!m_fixed_done)

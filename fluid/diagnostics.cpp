@@ -16,20 +16,23 @@ Extremum cfl(const Solver& s, double dt) {
   const Grid& g = s.grid();
   const double *xwi = g.x().wi(), *ywi = g.y().wi();
   Extremum e;
+  // std::max drops a NaN in its second argument: the added 0 * (sum of the four values) is 0
+  // for finite values and NaN when any of them is NaN or infinite.
   auto local = [&](const double* u, const double* v, const double* vn, double wy, int i) {
     return std::max(std::abs(u[i]), std::abs(u[i + 1])) * xwi[i] +
-           std::max(std::abs(v[i]), std::abs(vn[i])) * wy;
+           std::max(std::abs(v[i]), std::abs(vn[i])) * wy + 0.0 * (u[i] + u[i + 1] + v[i] + vn[i]);
   };
   for (int j = 0; j < g.ny(); ++j) {
     const double* u = s.u().row(j);
     const double* v = s.v().row(j);
     const double* vn = s.v().row(j + 1);
     const double wy = ywi[j];
-    // c >= 0 or NaN (|.| clears the sign): its bits order like its value as a signed integer,
-    // +Inf above every finite value and NaN above +Inf, so an integer max finds both.
+    // |c| (the sign bit cleared, also of a NaN that an invalid operation made negative): its
+    // bits order like its value as a signed integer, +Inf above every finite value and NaN above
+    // +Inf, so an integer max finds both.
     std::int64_t mb = 0;
     for (int i = 0; i < g.nx(); ++i) {
-      const std::int64_t b = std::bit_cast<std::int64_t>(local(u, v, vn, wy, i));
+      const std::int64_t b = std::bit_cast<std::int64_t>(std::abs(local(u, v, vn, wy, i)));
       mb = b > mb ? b : mb;
     }
     const double m = std::bit_cast<double>(mb);

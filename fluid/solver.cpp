@@ -193,8 +193,9 @@ void Solver::end_step(double dt, const CouplingIn& in, CouplingOut& out) {
 // `fibers` is given).
 void Solver::predict(double dt, const CouplingIn* fibers) {
   if (!(dt > 0)) throw std::invalid_argument("fluid::Solver::step: dt must be > 0");
+  if (m_begun_dt != 0)
+    throw std::invalid_argument("fluid::Solver: a step was begun (begin_step) and not ended");
   const double t_new = m_t + dt;
-  m_begun_dt = 0;
   auto t0 = Clock::now();
   // Explicit terms at t^n (ghosts of u^n are filled), unless prepare_next_step() did them.
   const bool imp = m_cfg.implicit;
@@ -537,6 +538,7 @@ void Solver::project(double dt) {
 }
 
 void Solver::project_initial() {
+  m_prepared_step = -1;  // the fields change: prepared explicit terms no longer hold
   m_bnd.advance_normal(m_u, m_v, m_t, 0.0);
   const Field p = m_p;
   project(1.0);

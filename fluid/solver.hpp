@@ -92,7 +92,8 @@ class Solver {
   void prepare_next_step();
 
   // Fields. u: (nx+1) x ny, v: nx x (ny+1), p: nx x ny, with ghosts (Field). After set-up of
-  // u and v by hand, call project_initial().
+  // u and v by hand, call project_initial() (which also drops terms prepare_next_step() made
+  // from the fields before).
   Field& u() { return m_u; }
   Field& v() { return m_v; }
   Field& p() { return m_p; }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 
@@ -622,7 +623,8 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
 bool Solver::factorize_cached() {
   const double* v = m_matrix.valuePtr();
   const auto nnz = static_cast<std::size_t>(m_matrix.nonZeros());
-  if (m_factored_valid && m_factored.size() == nnz && std::equal(v, v + nnz, m_factored.begin())) {
+  if (m_factored_valid && m_factored.size() == nnz &&
+      std::memcmp(v, m_factored.data(), nnz * sizeof(double)) == 0) {
     ++m_factor_reuses;
     return true;
   }
@@ -635,6 +637,9 @@ bool Solver::factorize_cached() {
 
 void Solver::factorize_ahead(double dt) {
   if (m_bodies.empty() || m_neq == 0 || m_model.settings.analysis != Analysis::dynamic) return;
+  // Active contact adds its curvature to iteration 0's matrix after assembly: no match to hope for.
+  for (const auto& s : m_contact.slots())
+    if (s.active) return;
   for (auto& bp : m_bodies) {  // as advance() begins (the residual's inertia reads them)
     bp->u_old = bp->u;
     bp->v_old = bp->v;

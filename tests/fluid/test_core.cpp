@@ -288,4 +288,12 @@ TEST_CASE("CFL number: value, cell and non-finite fields", "[fluid][health]") {
   CHECK(std::isnan(cfl(s, 0.5).value));
   s.v()(3, 20) = std::numeric_limits<double>::quiet_NaN();
   CHECK(std::isnan(cfl(s, 0.5).value));
+  s.v()(3, 20) = 0;
+  CHECK(std::isfinite(cfl(s, 0.5).value));
+  // On the last face of a row or column (the second argument of each max).
+  s.u()(g.nx(), 5) = std::numeric_limits<double>::quiet_NaN();
+  CHECK(std::isnan(cfl(s, 0.5).value));
+  s.u()(g.nx(), 5) = 0;
+  s.v()(2, g.ny()) = std::numeric_limits<double>::quiet_NaN();
+  CHECK(std::isnan(cfl(s, 0.5).value));
 }

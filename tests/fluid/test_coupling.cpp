@@ -232,3 +232,30 @@ TEST_CASE("a step in two parts equals the step", "[fluid][coupling]") {
     }
   }
 }
+
+// The program's sequence in a coupled run: explicit terms prepared after each step, the step
+// begun before its input and ended with it; the same fields as plain steps. Beginning a step
+// twice is refused.
+TEST_CASE("prepared, begun and ended steps equal plain steps", "[fluid][coupling]") {
+  for (bool implicit : {false, true}) {
+    Config c = box(BcType::wall);
+    c.implicit = implicit;
+    const double dt = 1e-3;
+    Solver a(c, dt), b(c, dt);
+    BlockInput block(a);
+    CouplingOut oa, ob;
+    for (int n = 0; n < 5; ++n) {
+      a.step(dt, block.in, oa);
+      b.begin_step(dt);
+      b.end_step(dt, block.in, ob);
+      b.prepare_next_step();
+    }
+    a.step(dt, block.in, oa);
+    b.begin_step(dt);
+    b.end_step(dt, block.in, ob);
+    check_same(a, b, oa, ob);
+    b.begin_step(dt);
+    CHECK_THROWS_WITH(b.begin_step(dt), Catch::Contains("begun"));
+    CHECK_THROWS_WITH(b.step(dt, block.in, ob), Catch::Contains("begun"));
+  }
+}
