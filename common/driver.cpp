@@ -96,12 +96,12 @@ void follow(Runtime& rt, Port& port, Advance advance) {
            sb.step, sb.iteration, steps - 1);
     if (sb.iteration == 0) {
       rt.check_fault(sb.step);
-      timed(ahead_seconds, [&] { port.begin(sb); });
+      if (s.work_ahead) timed(ahead_seconds, [&] { port.begin(sb); });
     } else {
       ++repeats;
     }
     advance(sb, port_seconds);
-    if (sb.may_repeat == 0 && sb.step + 1 < s.steps)
+    if (s.work_ahead && sb.may_repeat == 0 && sb.step + 1 < s.steps)
       timed(ahead_seconds, [&] { port.prepare_next(sb); });
     steps = sb.step + 1;
     t_done = sb.time + sb.dt;

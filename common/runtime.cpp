@@ -144,6 +144,7 @@ CommonSettings read_common(const SceneTable& root) {
     }
     if (test->has("bad_protocol_version"))
       s.bad_version_role = test->choice("bad_protocol_version", roles);
+    s.work_ahead = test->boolean("work_ahead", true);
     test->finish();
   }
   return s;

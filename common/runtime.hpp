@@ -57,6 +57,7 @@ struct CommonSettings {
   std::string fail_role;    // test.fail_role: this program fails ...
   long fail_step = -1;      // ... at the start of this step
   std::string bad_version_role;  // test.bad_protocol_version: this program announces a wrong version
+  bool work_ahead = true;   // test.work_ahead = false: the solvers do no work ahead of their input
 };
 CommonSettings read_common(const SceneTable& root);
 
