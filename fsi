@@ -251,6 +251,10 @@ print("  solid factorises its first Newton matrix while the fluid steps; factor 
       " is unchanged | -3 ms | solid round trip 8.5 -> 4.2 ms, whole step 19-22 ms")
 print("  solid's step_begin after the footprint (its factorisation no longer beside the clipping) |"
       " -1 ms | 17.2-18.4 ms; all together 24.7-27.4 -> 17.3-18.8 ms (x 0.69)")
+print("  a step that cannot be repeated is committed once answered; the fluid begins the next one"
+      " (explicit terms and predictor) at once, beside the solid's step | -1 ms | 15.1-17.0 ms,"
+      " messages 1.3-1.6 -> 0.6-1.0 ms, footprint 2.0-3.1 -> 1.6-2.5 ms; all together 26.0-29.4"
+      " -> 14.4-17.8 ms (x 0.56-0.61)")
 print("  waiting paced by the expected arrival instead of a fixed 200 us cap | faster pick-up |"
       " none measurable (messages 1.0-1.4 fixed, 1.4-1.6 ms paced): not kept")
 print("  work ahead on a thread of its own at nice 19 (so a waking coupler gets a core at once) |"

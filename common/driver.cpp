@@ -66,8 +66,9 @@ void run_alone(Runtime& rt, Port& port, Advance advance) {
 }
 
 // Coupled: follow the coupler's step_begin messages until it says stop. A step is committed,
-// and its output written, when the next step begins with iteration 0 or the run stops: an
-// iteration k > 0 repeats the step just done (PROTOCOL.md, "Coupled iterations").
+// and its output written, once answered when it cannot be repeated (may_repeat = 0), else when
+// the next step begins with iteration 0 or the run stops: an iteration k > 0 repeats the step
+// just done (PROTOCOL.md, "Coupled iterations").
 template <class Port, class Advance>
 void follow(Runtime& rt, Port& port, Advance advance) {
   Link& c = rt.coupler_link();
@@ -101,11 +102,15 @@ void follow(Runtime& rt, Port& port, Advance advance) {
       ++repeats;
     }
     advance(sb, port_seconds);
-    if (s.work_ahead && sb.may_repeat == 0 && sb.step + 1 < s.steps)
-      timed(ahead_seconds, [&] { port.prepare_next(sb); });
     steps = sb.step + 1;
     t_done = sb.time + sb.dt;
     pending = true;
+    if (sb.may_repeat == 0) {
+      // A step that cannot be repeated is final once answered: commit it now, then work ahead.
+      port.output(steps, t_done, is_output_step(s, steps));
+      pending = false;
+      if (s.work_ahead && steps < s.steps) timed(ahead_seconds, [&] { port.prepare_next(sb); });
+    }
   }
   nlohmann::json j = port.report();
   j["wall_time"] = rt.wall_seconds();

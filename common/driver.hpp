@@ -26,9 +26,9 @@ class SolverPort {
   // Work ahead of the input, done while this solver would otherwise wait for it (the coupler is
   // meanwhile running the other solvers or its own transfers); advance() must give the same
   // result with or without it. prepare_next(): after the answer to step `done` was sent, when
-  // that step cannot be repeated (done.may_repeat == 0) and another follows (the previous step is
-  // not yet committed: its output is still to be written). begin(): on receiving step_begin for
-  // a new step (iteration 0), after the previous step's output, before its input.
+  // that step cannot be repeated (done.may_repeat == 0) and another follows; that step is then
+  // committed (output() was called), so the port may change its state. begin(): on receiving
+  // step_begin for a new step (iteration 0), after the previous step's output, before its input.
   virtual void prepare_next(const proto::StepBegin& done) { (void)done; }
   virtual void begin(const proto::StepBegin& s) { (void)s; }
 };

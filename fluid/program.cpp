@@ -54,9 +54,20 @@ fsi::proto::GridInfo FluidProgram::grid_info() const {
 }
 
 // The step's first part (explicit terms, boundary values, the predictor) needs no coupling input,
-// except the fibers' force inside a Crank-Nicolson solve: then the whole step waits for it.
+// except the fibers' force inside a Crank-Nicolson solve: then only the explicit terms are done
+// ahead. After a final step it starts at once (the next step has the same dt: the coupler's
+// clock is uniform), else on step_begin.
+void FluidProgram::prepare_next(const fsi::proto::StepBegin& done) {
+  if (m_cfg.implicit && m_rt.roles()[fsi::Role::fiber]) {
+    m_solver->prepare_next_step();
+    return;
+  }
+  m_solver->begin_step(done.dt);
+  m_begun = true;
+}
+
 void FluidProgram::begin(const fsi::proto::StepBegin& s) {
-  if (m_cfg.implicit && m_rt.roles()[fsi::Role::fiber]) return;
+  if (m_begun || (m_cfg.implicit && m_rt.roles()[fsi::Role::fiber])) return;
   m_solver->begin_step(s.dt);
   m_begun = true;
 }

@@ -20,7 +20,7 @@ class FluidProgram : public fsi::FluidPort {
   void advance(const fsi::proto::StepBegin& s, const fsi::proto::FluidInput& in,
                fsi::proto::FluidOutput& out) override;
   bool can_iterate() const override { return true; }
-  void prepare_next(const fsi::proto::StepBegin&) override { m_solver->prepare_next_step(); }
+  void prepare_next(const fsi::proto::StepBegin& done) override;
   void begin(const fsi::proto::StepBegin& s) override;
   void output(long step, double t, bool fields) override;
   std::string status() const override;
