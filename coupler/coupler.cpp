@@ -249,10 +249,22 @@ void Coupler::check_bodies_in_domain(long step) const {
   for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b) {
     const auto& x = m_solid.x[b];
     for (std::size_t k = 0; k + 1 < x.size(); k += 2) {
-      if (const char* side = outside(x[k], x[k + 1]))
+      if (const char* side = outside(x[k], x[k + 1])) {
+        // Thrown out by the explicit coupling's instability before check_growth() could count
+        // growth_steps steps of it: say so, it is the cause to fix.
+        const long grew = b < m_growing.size() ? m_growing[b] : 0;
+        const std::string cause =
+            grew > 0 ? fmt::format("; its motion grew and reversed in the {} step(s) before: the "
+                                   "explicit coupling cannot hold this body at this density "
+                                   "ratio (make it heavier, or turn on coupled iterations, "
+                                   "[coupler.iterations] max > 1)",
+                                   grew)
+                     : std::string();
         fsi::fail("body '{}' is outside the fluid domain [{}, {}] x [{}, {}] through its {} "
-                  "boundary at step {}: node {} at ({}, {})",
-                  m_meshes.bodies[b].name, x0, x1, y0, y1, side, step, k / 2, x[k], x[k + 1]);
+                  "boundary at step {}: node {} at ({}, {}){}",
+                  m_meshes.bodies[b].name, x0, x1, y0, y1, side, step, k / 2, x[k], x[k + 1],
+                  cause);
+      }
     }
   }
 }
@@ -317,7 +329,8 @@ void Coupler::check_growth(long step) {
       fsi::fail("body '{}' is unstable at step {}: its kinetic energy per unit density "
                 "1/2 int |v|^2 dA = {:.3g} grew by more than a factor {} and its velocity "
                 "reversed in each of the last {} steps: the explicit coupling cannot hold this "
-                "time.dt = {} (lower it, or make the body heavier)",
+                "time.dt = {} (lower it, make the body heavier, or turn on coupled iterations, "
+                "[coupler.iterations] max > 1)",
                 body.name, step, e, m_growth_factor, m_growth_steps, m_rt.settings().dt);
   }
 }
