@@ -257,6 +257,9 @@ print("  a step that cannot be repeated is committed once answered; the fluid be
       " -> 14.4-17.8 ms (x 0.56-0.61)")
 print("  waiting paced by the expected arrival instead of a fixed 200 us cap | faster pick-up |"
       " none measurable (messages 1.0-1.4 fixed, 1.4-1.6 ms paced): not kept")
+print("  the coupler alone with a 50 us sleep cap (the hub picks its answers up sooner) | -0.3 ms |"
+      " messages 1.1 -> 0.8 ms but the whole step no shorter (15.6-16.0 against 14.5-16.4 ms) and the"
+      " default scene slower (3.9-5.7 against 3.4-4.2 ms): not kept")
 print("  work ahead on a thread of its own at nice 19 (so a waking coupler gets a core at once) |"
       " -1 ms messages | worse: 18.2-22.7 ms (messages 2.1-3.3: the fluid's predictor starved beside"
       " the clipping, with one footprint thread too): not kept")
