@@ -58,7 +58,7 @@ fsi::proto::GridInfo FluidProgram::grid_info() const {
 // ahead. After a final step it starts at once (the next step has the same dt: the coupler's
 // clock is uniform), else on step_begin.
 void FluidProgram::prepare_next(const fsi::proto::StepBegin& done) {
-  if (m_cfg.implicit && m_rt.roles()[fsi::Role::fiber]) {
+  if (!m_begin_ahead) {
     m_solver->prepare_next_step();
     return;
   }
@@ -67,7 +67,7 @@ void FluidProgram::prepare_next(const fsi::proto::StepBegin& done) {
 }
 
 void FluidProgram::begin(const fsi::proto::StepBegin& s) {
-  if (m_begun || (m_cfg.implicit && m_rt.roles()[fsi::Role::fiber])) return;
+  if (m_begun || !m_begin_ahead) return;
   m_solver->begin_step(s.dt);
   m_begun = true;
 }

@@ -506,9 +506,24 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
           B.q[d] += fe[2 * a + i];
           absq[d] += std::abs(fe[2 * a + i]);
         }
+      // The element's mass matrix (unit density), for the inertia and the coupled iterations'
+      // term; each removes scale(k) * (M vec)_k from the residual and adds scale(k) * (M |vec|)_k
+      // to its round-off floor, k = 2a + i.
+      double me[3][3] = {};
+      if (dynamic && (B.rho_inertia[e] > 0 || iter_w)) element_mass(B.geo[e].area, lumped, me);
+      auto mass_terms = [&](const double* vec, const double* vec_abs, auto scale) {
+        for (int a = 0; a < 3; ++a)
+          for (int i = 0; i < 2; ++i) {
+            double m = 0, mabs = 0;
+            for (int c = 0; c < 3; ++c) {
+              m += me[a][c] * vec[2 * c + i];
+              mabs += me[a][c] * vec_abs[2 * c + i];
+            }
+            r[2 * t[a] + i] -= scale(2 * a + i) * m;
+            absm[2 * t[a] + i] += scale(2 * a + i) * mabs;
+          }
+      };
       if (dynamic && B.rho_inertia[e] > 0) {
-        double me[3][3];
-        element_mass(B.geo[e].area, lumped, me);
         const double rho = B.rho_inertia[e];
         double w[6], wabs[6];
         for (int a = 0; a < 3; ++a)
@@ -517,16 +532,7 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
             w[2 * a + i] = B.u[d] - B.u_old[d] - dt * B.v_old[d];
             wabs[2 * a + i] = std::abs(B.u[d]) + std::abs(B.u_old[d]) + dt * std::abs(B.v_old[d]);
           }
-        for (int a = 0; a < 3; ++a)
-          for (int i = 0; i < 2; ++i) {
-            double m = 0, mabs = 0;
-            for (int c = 0; c < 3; ++c) {
-              m += me[a][c] * w[2 * c + i];
-              mabs += me[a][c] * wabs[2 * c + i];
-            }
-            r[2 * t[a] + i] -= c0 * rho * m;
-            absm[2 * t[a] + i] += c0 * rho * mabs;
-          }
+        mass_terms(w, wabs, [&](int) { return c0 * rho; });
         if (with_matrix)
           for (int a = 0; a < 3; ++a)
             for (int c = 0; c < 3; ++c)
@@ -543,8 +549,6 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
         // The term vanishes when the step returns v^(n+1) = w (a converged iteration), and it
         // gives a body without excess mass (rho_s = rho_f) the inertia rho_f it otherwise lacks
         // within the step: a free neutrally buoyant body has a regular matrix.
-        double me[3][3];
-        element_mass(B.geo[e].area, lumped, me);
         const double rf = m_model.settings.fluid_density;
         double sw[6], dv[6], vabs[6];  // vabs: |v| + |w|, the scale of the terms that cancel
         for (int c = 0; c < 6; ++c) {
@@ -555,16 +559,7 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
           dv[c] = v - (*iter_w)[d];
           vabs[c] = std::abs(v) + std::abs((*iter_w)[d]);
         }
-        for (int a = 0; a < 3; ++a)
-          for (int i = 0; i < 2; ++i) {
-            double m = 0, mabs = 0;
-            for (int c = 0; c < 3; ++c) {
-              m += me[a][c] * dv[2 * c + i];
-              mabs += me[a][c] * vabs[2 * c + i];
-            }
-            r[2 * t[a] + i] -= sw[2 * a + i] * rf / dt * m;
-            absm[2 * t[a] + i] += sw[2 * a + i] * rf / dt * mabs;
-          }
+        mass_terms(dv, vabs, [&](int k) { return sw[k] * rf / dt; });
         if (with_matrix)
           for (int a = 0; a < 3; ++a)
             for (int c = 0; c < 3; ++c)
@@ -635,16 +630,20 @@ bool Solver::factorize_cached() {
   return true;
 }
 
+void Solver::keep_step_start() {
+  for (auto& bp : m_bodies) {
+    bp->u_old = bp->u;
+    bp->v_old = bp->v;
+  }
+}
+
 void Solver::factorize_ahead(double dt) {
   if (m_bodies.empty() || m_neq == 0 || m_model.settings.analysis != Analysis::dynamic) return;
   // Active contact adds its curvature to iteration 0's matrix after assembly: no match to hope for.
   for (const auto& s : m_contact.slots())
     if (s.active) return;
-  for (auto& bp : m_bodies) {  // as advance() begins (the residual's inertia reads them)
-    bp->u_old = bp->u;
-    bp->v_old = bp->v;
-  }
-  assemble(4 / (dt * dt), dt, true, m_time + dt, nullptr);
+  keep_step_start();  // as advance() begins (the residual's inertia reads them)
+  assemble(newmark_c0(dt), dt, true, m_time + dt, nullptr);
   if (m_residual.allFinite()) factorize_cached();
 }
 
@@ -993,10 +992,7 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
                         ? bp->f_ext[d] - bp->q[d]
                         : 0.0;
   }
-  for (auto& bp : m_bodies) {
-    bp->u_old = bp->u;
-    bp->v_old = bp->v;
-  }
+  keep_step_start();
   update_rigid(t1);
   prepare_prescribed(t1);
   m_contact_force_factor = 0.5;
@@ -1006,7 +1002,7 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
           : nullptr;
   StepReport rep;
   try {
-    rep = newton(4 / (dt * dt), dt, t1, external, when);
+    rep = newton(newmark_c0(dt), dt, t1, external, when);
   } catch (...) {
     m_iteration_velocity = nullptr;
     throw;
@@ -1065,10 +1061,7 @@ StepReport Solver::solve_static_step(double factor) {
   const std::string when = fmt::format("load factor {:.6g}", factor);
   prepare_prescribed(factor);
   m_contact_force_factor = 1.0;
-  for (auto& bp : m_bodies) {
-    bp->u_old = bp->u;
-    bp->v_old = bp->v;
-  }
+  keep_step_start();
   StepReport rep = newton(0, 0, factor, nullptr, when);
   check_finite(when);
   check_inverted(when);

@@ -158,6 +158,11 @@ class Solver {
                     const std::vector<std::vector<double>>* external, const std::string& when);
   void factorize(const std::string& when);
   bool factorize_cached();
+  // u_old, v_old := u, v: the state the coming step starts from.
+  void keep_step_start();
+  // The Newmark (trapezoidal) inertia factor of the effective matrix, c0 = 4 / dt^2: one
+  // expression for advance() and factorize_ahead(), whose matrices must agree bit for bit.
+  static double newmark_c0(double dt) { return 4 / (dt * dt); }
   [[noreturn]] void fail_health(const std::string& what, int body, int element,
                                 const std::string& when) const;
   void check_finite(const std::string& when) const;
