@@ -53,21 +53,17 @@ fsi::proto::GridInfo FluidProgram::grid_info() const {
   return gi;
 }
 
-// The step's first part (explicit terms, boundary values, the predictor) needs no coupling input,
-// except the fibers' force inside a Crank-Nicolson solve: then only the explicit terms are done
-// ahead. After a final step it starts at once (the next step has the same dt: the coupler's
-// clock is uniform), else on step_begin.
+// The step's first part (explicit terms, boundary values, the predictor; with Crank-Nicolson its
+// right-hand side, the solve waiting for the forces) needs no coupling input. After a final step
+// it starts at once (the next step has the same dt: the coupler's clock is uniform), else on
+// step_begin.
 void FluidProgram::prepare_next(const fsi::proto::StepBegin& done) {
-  if (!m_begin_ahead) {
-    m_solver->prepare_next_step();
-    return;
-  }
   m_solver->begin_step(done.dt);
   m_begun = true;
 }
 
 void FluidProgram::begin(const fsi::proto::StepBegin& s) {
-  if (m_begun || !m_begin_ahead) return;
+  if (m_begun) return;
   m_solver->begin_step(s.dt);
   m_begun = true;
 }

@@ -40,9 +40,6 @@ class FluidProgram : public fsi::FluidPort {
   std::vector<double> m_row, m_w1, m_w2;
   CouplingOut m_out;
   bool m_begun = false;  // begin() took the step's first part
-  // The step's first part may run before its input: not with Crank-Nicolson and fibers, whose
-  // force enters the predictor's solve.
-  bool m_begin_ahead = !(m_cfg.implicit && m_rt.roles()[fsi::Role::fiber]);
   double m_cfl = 0, m_div = 0, m_div_first = -1;
   double m_energy = 0;  // kinetic energy, refreshed with the divergence every health.every steps
   long m_written_step = -1;

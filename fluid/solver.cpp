@@ -2,6 +2,7 @@
 // right-hand side, solve, correct.
 #include "solver.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -178,9 +179,6 @@ void Solver::end_step(double dt, const CouplingIn& in, CouplingOut& out) {
   if (m_begun_dt != dt)
     throw std::invalid_argument("fluid::Solver::end_step: no step of this dt begun");
   const bool fibers = !in.fiber_u_index.empty() || !in.fiber_v_index.empty();
-  if (fibers && m_cfg.implicit)
-    throw std::invalid_argument("fluid::Solver::end_step: the Crank-Nicolson predictor takes the "
-                                "fibers' force inside its solve; take the step with step()");
   if (fibers) {
     const auto t0 = Clock::now();
     add_fiber_force(dt, in);
@@ -197,10 +195,9 @@ void Solver::predict(double dt, const CouplingIn* fibers) {
     throw std::invalid_argument("fluid::Solver: a step was begun (begin_step) and not ended");
   const double t_new = m_t + dt;
   auto t0 = Clock::now();
-  // Explicit terms at t^n (ghosts of u^n are filled), unless prepare_next_step() did them.
+  // Explicit terms at t^n (ghosts of u^n are filled).
   const bool imp = m_cfg.implicit;
-  if (m_prepared_step != m_step) explicit_terms();
-  m_prepared_step = -1;
+  explicit_terms();
   m_time.predictor += since(t0);
 
   // Boundary values at t^{n+1}; Crank-Nicolson also needs the ghosts with the new wall data.
@@ -213,11 +210,11 @@ void Solver::predict(double dt, const CouplingIn* fibers) {
   if (m_step == 0) m_dt_prev = dt;
   if (imp) {
     if (dt != m_dt_implicit) build_implicit(dt);
-    predictor_implicit(dt, m_t + 0.5 * dt, fibers);
+    predictor_implicit(dt, m_t + 0.5 * dt);
   } else {
     predictor(dt, m_t + 0.5 * dt);
-    if (fibers) add_fiber_force(dt, *fibers);
   }
+  if (fibers) add_fiber_force(dt, *fibers);
   m_time.predictor += since(t0);
 }
 
@@ -246,14 +243,6 @@ void Solver::explicit_terms() {
                  imp ? &m_lu : nullptr, imp ? &m_lv : nullptr);
 }
 
-void Solver::prepare_next_step() {
-  const auto t0 = Clock::now();
-  explicit_terms();
-  m_prepared_step = m_step;
-  m_can_redo = false;
-  m_time.predictor += since(t0);
-}
-
 void Solver::redo_step(double dt, const CouplingIn& in, CouplingOut& out) {
   if (m_step == 0 || dt != m_dt_prev || !m_can_redo)
     throw std::invalid_argument("fluid::Solver::redo_step: no step of this dt kept for a redo");
@@ -274,7 +263,8 @@ void Solver::redo_step(double dt, const CouplingIn& in, CouplingOut& out) {
 // u^(n+1); then t^n -> t^(n+1).
 void Solver::finish_step(double dt, const CouplingIn& in, CouplingOut& out) {
   auto t0 = Clock::now();
-  immersed_forcing(dt, in, out);
+  if (m_cfg.implicit) solve_implicit(dt, in, out);
+  else immersed_forcing(dt, in, out);
   m_time.predictor += since(t0);
 
   project(dt);
@@ -335,11 +325,30 @@ void Solver::predictor(double dt, double t_half) {
   }
 }
 
-// u~ += dt f_f / rho on the fibers' faces (the explicit predictor's last term).
+// u~ += dt f_f / rho on the fibers' faces (the explicit predictor's last term). Crank-Nicolson:
+// the same term in its stored right-hand side and in the estimate u^ (predictor_implicit).
 void Solver::add_fiber_force(double dt, const CouplingIn& in) {
   const double ri = 1.0 / m_cfg.density;
   const int nx = m_grid.nx(), ny = m_grid.ny();
   const int nu = m_grid.nu();
+  if (m_cfg.implicit) {
+    const double scale = -1.0 / (0.5 * m_nu * dt);
+    for (int comp = 0; comp < 2; ++comp) {
+      const auto& idx = comp == 0 ? in.fiber_u_index : in.fiber_v_index;
+      const auto& frc = comp == 0 ? in.fiber_u_force : in.fiber_v_force;
+      const int ib = comp == 0 ? m_i0 : 0, jb = comp == 0 ? 0 : m_j0;
+      const int nt = (comp == 0 ? m_helm_u : m_helm_v)->nt();
+      for (std::size_t q = 0; q < idx.size(); ++q) {
+        const int i = comp == 0 ? int(idx[q] % nu) : int(idx[q] % nx);
+        const int j = comp == 0 ? int(idx[q] / nu) : int(idx[q] / nx);
+        if (i < ib || i >= nx || j < jb || j >= ny) continue;
+        const int k = buf_index(i, j, ib, jb, nt);
+        m_rhs[comp][k] += scale * dt * ri * frc[q];
+        m_hat[comp][k] += dt * ri * frc[q];
+      }
+    }
+    return;
+  }
   for (std::size_t q = 0; q < in.fiber_u_index.size(); ++q) {
     const auto idx = in.fiber_u_index[q];
     const int i = int(idx % nu), j = int(idx / nu);
@@ -353,14 +362,31 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
 }
 
 // Crank-Nicolson predictor, theta = nu dt / 2:
-//   (I - theta L) u~ = u^n + dt [AB2(-div(u u)) - G p^n / rho + f / rho + f_f / rho]
-//                      + theta L u^n + theta b^{n+1}
+//   (I - theta L) u~ = B + dt f_s / rho,
+//   B  = u^n + dt [AB2(-div(u u)) - G p^n / rho + f / rho + f_f / rho] + theta L u^n
+//        + theta b^{n+1},
 // with b^{n+1} the boundary data at t^{n+1}. L is solved as the fast solver's L0, which equals L
 // except in the transform direction next to a wall or an outflow, where L0 uses the nearest
 // closure a real transform diagonalises (ghost -q0 or +q0). The difference is carried
 // explicitly with u^n, so a steady state is that of L exactly; this is stable for
 // nu dt / h_t^2 < 2 (checked by validate()).
-void Solver::predictor_implicit(double dt, double t_half, const CouplingIn* in) {
+//
+// The immersed solid's forcing enters the solve (solve_implicit), computed from the explicit
+// estimate
+//   u^ = u^n + dt [AB2(-div(u u)) - G p^n / rho + f / rho + f_f / rho] + 2 theta L u^n
+// (the paper's predictor, with the step's diffusion taken explicitly):
+//   f_s = rho alpha (u_s - u^) / dt.
+// At a steady state (u~ = u^n = u) the solve reads 0 = (u^ - u) + alpha (u_s - u^), i.e.
+// u = (1 - alpha) u^ + alpha u_s: the explicit scheme's balance, whatever theta. Forcing the
+// solve's result u~ after it instead lets the implicit term diffuse the unforced prediction
+// inside the body, and the wall the flow sees moves by lambda = nu dt / h^2 (runs/sub-cell-wall).
+// Inside the body (alpha = 1) u~ = u_s + theta L (u~ - u^n): u_s up to the diffusion of the
+// step's change.
+//
+// This assembles B (scaled by -1/theta, as the Helmholtz solver takes it) and u^, both in the
+// solver's layout, into m_rhs and m_hat; they are kept until the step is over (a redo of the
+// step solves again from them).
+void Solver::predictor_implicit(double dt, double t_half) {
   const double c1 = m_step == 0 ? 1.0 : 1.0 + 0.5 * dt / m_dt_prev;
   const double c0 = m_step == 0 ? 0.0 : -0.5 * dt / m_dt_prev;
   const auto acc = body_acceleration(t_half);
@@ -375,10 +401,13 @@ void Solver::predictor_implicit(double dt, double t_half, const CouplingIn* in) 
     const Field& H = comp == 0 ? m_hu : m_hv;
     const Field& Ho = comp == 0 ? m_hu_old : m_hv_old;
     const Field& L = comp == 0 ? m_lu : m_lv;
-    FastSolver& hs = comp == 0 ? *m_helm_u : *m_helm_v;
+    const FastSolver& hs = comp == 0 ? *m_helm_u : *m_helm_v;
     const int ib = comp == 0 ? m_i0 : 0, jb = comp == 0 ? 0 : m_j0;
     const int nt = hs.nt();
-    double* buf = hs.data();
+    std::vector<double>& buf = m_rhs[comp];
+    std::vector<double>& hat = m_hat[comp];
+    buf.resize(std::size_t(hs.nt()) * hs.ns());
+    hat.resize(buf.size());
     const double* gd = comp == 0 ? X.di() : Y.di();
     for (int j = jb; j < ny; ++j) {
       const double* f = F.row(j);
@@ -390,7 +419,9 @@ void Solver::predictor_implicit(double dt, double t_half, const CouplingIn* in) 
       for (int i = ib; i < nx; ++i) {
         const double gp = (p[i] - pm[i]) * (comp == 0 ? gd[i] : gd[j]);
         const double rhs = f[i] + dt * (c1 * h[i] + c0 * ho[i] + acc[comp] - ri * gp) + theta * l[i];
-        buf[buf_index(i, j, ib, jb, nt)] = scale * rhs;
+        const int k = buf_index(i, j, ib, jb, nt);
+        buf[k] = scale * rhs;
+        hat[k] = rhs + theta * l[i];
       }
     }
     // Boundary rows: theta * coef * (value beyond the row at t^{n+1} - what the solved operator
@@ -426,16 +457,40 @@ void Solver::predictor_implicit(double dt, double t_half, const CouplingIn* in) 
         }
       }
     }
-    if (in) {
-      const auto& idx = comp == 0 ? in->fiber_u_index : in->fiber_v_index;
-      const auto& frc = comp == 0 ? in->fiber_u_force : in->fiber_v_force;
-      const int nu = m_grid.nu();
-      for (std::size_t q = 0; q < idx.size(); ++q) {
-        const int i = comp == 0 ? int(idx[q] % nu) : int(idx[q] % nx);
-        const int j = comp == 0 ? int(idx[q] / nu) : int(idx[q] / nx);
-        if (i < ib || i >= nx || j < jb || j >= ny) continue;
-        buf[buf_index(i, j, ib, jb, nt)] += scale * dt * ri * frc[q];
+  }
+}
+
+// The Crank-Nicolson solve of the step (predictor_implicit): B + alpha (u_s - u^) on the solid's
+// faces, i.e. B + dt f_s / rho with f_s = rho alpha (u_s - u^) / dt, then u~ = (I - theta L)^-1.
+void Solver::solve_implicit(double dt, const CouplingIn& in, CouplingOut& out) {
+  const double rho = m_cfg.density;
+  const double scale = -1.0 / (0.5 * m_nu * dt);
+  const int nx = m_grid.nx(), ny = m_grid.ny(), nu = m_grid.nu();
+  for (int comp = 0; comp < 2; ++comp) {
+    Field& F = comp == 0 ? m_u : m_v;
+    FastSolver& hs = comp == 0 ? *m_helm_u : *m_helm_v;
+    const int ib = comp == 0 ? m_i0 : 0, jb = comp == 0 ? 0 : m_j0;
+    const int nt = hs.nt();
+    const std::vector<double>& rhs = m_rhs[comp];
+    const std::vector<double>& hat = m_hat[comp];
+    double* buf = hs.data();
+    std::copy(rhs.begin(), rhs.end(), buf);
+    const auto& idx = comp == 0 ? in.solid_u_index : in.solid_v_index;
+    const auto& alpha = comp == 0 ? in.solid_u_alpha : in.solid_v_alpha;
+    const auto& us = comp == 0 ? in.solid_u_velocity : in.solid_v_velocity;
+    auto& force = comp == 0 ? out.solid_u_force : out.solid_v_force;
+    force.resize(idx.size());
+    for (std::size_t q = 0; q < idx.size(); ++q) {
+      const int i = comp == 0 ? int(idx[q] % nu) : int(idx[q] % nx);
+      const int j = comp == 0 ? int(idx[q] / nu) : int(idx[q] / nx);
+      double f = 0;
+      if (i >= ib && i < nx && j >= jb && j < ny) {
+        const int k = buf_index(i, j, ib, jb, nt);
+        const double du = alpha[q] * (us[q] - hat[k]);
+        f = rho * du / dt;
+        buf[k] += scale * du;
       }
+      force[q] = f;
     }
     hs.solve();
     for (int j = jb; j < ny; ++j) {
@@ -538,7 +593,6 @@ void Solver::project(double dt) {
 }
 
 void Solver::project_initial() {
-  m_prepared_step = -1;  // the fields change: prepared explicit terms no longer hold
   m_bnd.advance_normal(m_u, m_v, m_t, 0.0);
   const Field p = m_p;
   project(1.0);

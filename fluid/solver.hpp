@@ -5,6 +5,7 @@
 // solid forcing f_s, boundary conditions, Poisson right-hand side, solve, correct.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -72,28 +73,22 @@ class Solver {
   void step(double dt);
   void step(double dt, const CouplingIn& in, CouplingOut& out);
   // The same step in two parts, so that the first runs before the coupling input exists:
-  // begin_step() does everything up to the predictor u~ without the fibers' force; end_step()
-  // adds that force (explicit diffusion only: Crank-Nicolson takes it inside its solve and
-  // refuses fibers here), then the immersed forcing, projection and samples. Bit-identical to
-  // step(dt, in, out).
+  // begin_step() does everything up to the predictor u~ without the fibers' force (Crank-Nicolson:
+  // up to its right-hand side); end_step() adds that force, then the immersed forcing (inside
+  // the Crank-Nicolson solve), projection and samples. Bit-identical to step(dt, in, out).
   void begin_step(double dt);
   void end_step(double dt, const CouplingIn& in, CouplingOut& out);
   // Coupled iterations: the step just taken again from its predictor u~ and p^n (kept by
-  // step() while set_keep_for_redo(true), the default), with new solid input: immersed forcing,
-  // projection, samples. The fibers' force and the predictor are not recomputed (in.fiber_* is
+  // step() while set_keep_for_redo(true), the default; Crank-Nicolson: from its kept right-hand
+  // side and explicit estimate), with new solid input: immersed forcing (Crank-Nicolson: and
+  // its solve), projection, samples. The fibers' force and the predictor are not recomputed (in.fiber_* is
   // ignored). dt must be that of the step.
   void redo_step(double dt, const CouplingIn& in, CouplingOut& out);
   // Whether step() keeps u~, v~ and p^n for a redo (three copies of the grid each step).
   void set_keep_for_redo(bool keep) { m_keep_for_redo = keep; }
-  // Look-ahead: the next step's explicit terms H(u^n) (and L u^n of Crank-Nicolson) from the
-  // current fields, which the next step() then takes instead of computing them: the same
-  // numbers, computed while a coupled program waits for its input. The step just taken can no
-  // longer be redone (its terms' slot now holds the next step's).
-  void prepare_next_step();
 
   // Fields. u: (nx+1) x ny, v: nx x (ny+1), p: nx x ny, with ghosts (Field). After set-up of
-  // u and v by hand, call project_initial() (which also drops terms prepare_next_step() made
-  // from the fields before).
+  // u and v by hand, call project_initial().
   Field& u() { return m_u; }
   Field& v() { return m_v; }
   Field& p() { return m_p; }
@@ -121,7 +116,8 @@ class Solver {
   void end_predicted(double dt, const CouplingIn& in, CouplingOut& out);
   void predictor(double dt, double t_half);
   void add_fiber_force(double dt, const CouplingIn& fibers);
-  void predictor_implicit(double dt, double t_half, const CouplingIn* in);
+  void predictor_implicit(double dt, double t_half);
+  void solve_implicit(double dt, const CouplingIn& in, CouplingOut& out);
   void immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out);
   void project(double dt);
   void finish_step(double dt, const CouplingIn& in, CouplingOut& out);
@@ -145,9 +141,11 @@ class Solver {
   double m_t_start = 0, m_dt_prev_start = 0;
   bool m_keep_for_redo = true;
   bool m_can_redo = false;  // the last step() kept its predictor
-  long m_prepared_step = -1;  // m_step when prepare_next_step() filled the explicit terms
   double m_begun_dt = 0;      // dt of the step begin_step() began (0: none)
   std::unique_ptr<FastSolver> m_poisson, m_helm_u, m_helm_v;
+  // Crank-Nicolson: the step's right-hand side B (scaled) and explicit estimate u^, per component,
+  // in the Helmholtz solver's layout (predictor_implicit).
+  std::array<std::vector<double>, 2> m_rhs, m_hat;
   Timings m_time;
 };
 
