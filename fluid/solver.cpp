@@ -244,7 +244,7 @@ void Solver::explicit_terms() {
 }
 
 void Solver::redo_step(double dt, const CouplingIn& in, CouplingOut& out) {
-  if (m_step == 0 || dt != m_dt_prev || !m_can_redo)
+  if (m_step == 0 || dt != m_dt_prev || !m_can_redo || m_begun_dt != 0)
     throw std::invalid_argument("fluid::Solver::redo_step: no step of this dt kept for a redo");
   // Back to the end of the predictor: u~, p^n, the explicit terms in their step-n slots.
   m_u = m_u_pred;
@@ -380,8 +380,10 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
 // u = (1 - alpha) u^ + alpha u_s: the explicit scheme's balance, whatever theta. Forcing the
 // solve's result u~ after it instead lets the implicit term diffuse the unforced prediction
 // inside the body, and the wall the flow sees moves by lambda = nu dt / h^2 (runs/sub-cell-wall).
-// Inside the body (alpha = 1) u~ = u_s + theta L (u~ - u^n): u_s up to the diffusion of the
-// step's change.
+// Inside the body (alpha = 1) u~ = u_s + theta L0 (u~ - u^n) (+ the change of the boundary data
+// over the step next to a wall): u_s up to the diffusion of the step's change, a soft constraint
+// for short modes at large lambda (the grid-scale mode of the step's change of u_s is missed by
+// a fraction 4 lambda / (1 + 4 lambda); smooth ones, a rigid motion, by far less).
 //
 // This assembles B (scaled by -1/theta, as the Helmholtz solver takes it) and u^, both in the
 // solver's layout, into m_rhs and m_hat; they are kept until the step is over (a redo of the

@@ -42,7 +42,8 @@ struct CouplingIn {
 };
 // Output of one step:
 //   solid_*_force: f_s = rho_f alpha (u_s - u~) / dt on the solid's faces, in the input order,
-//                  force per unit volume ON THE FLUID (the solid receives its reaction).
+//                  force per unit volume ON THE FLUID (the solid receives its reaction);
+//                  Crank-Nicolson: u^, the explicit estimate, for u~ (predictor_implicit).
 //   sample_*:      u^(n+1) on the requested faces, in the input order.
 struct CouplingOut {
   std::vector<double> solid_u_force, solid_v_force;
@@ -84,7 +85,8 @@ class Solver {
   // its solve), projection, samples. The fibers' force and the predictor are not recomputed (in.fiber_* is
   // ignored). dt must be that of the step.
   void redo_step(double dt, const CouplingIn& in, CouplingOut& out);
-  // Whether step() keeps u~, v~ and p^n for a redo (three copies of the grid each step).
+  // Whether step() keeps u~, v~ (Crank-Nicolson: the fields before its solve) and p^n for a redo
+  // (three copies of the grid each step).
   void set_keep_for_redo(bool keep) { m_keep_for_redo = keep; }
 
   // Fields. u: (nx+1) x ny, v: nx x (ny+1), p: nx x ny, with ghosts (Field). After set-up of

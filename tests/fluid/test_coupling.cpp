@@ -181,7 +181,8 @@ TEST_CASE("redo of a step: same input, same fields; refused when not kept", "[fl
 // Work ahead of the input: the step begun before its input (explicit terms, boundary values,
 // the predictor or Crank-Nicolson's right-hand side) and ended with it gives the fields of plain
 // steps bit for bit, with the immersed forcing and the fibers' force, for both diffusion
-// options. Misuse is refused: a step begun twice, an end without a begin.
+// options. Misuse is refused: a step begun twice, an end without a begin, a redo of the step
+// before once the next is begun.
 TEST_CASE("work ahead gives the plain steps bit for bit", "[fluid][coupling]") {
   for (bool implicit : {false, true}) {
     CAPTURE(implicit);
@@ -210,6 +211,7 @@ TEST_CASE("work ahead gives the plain steps bit for bit", "[fluid][coupling]") {
     CHECK(std::abs(a.v()(10, 6)) > 1e-6);  // the fibers' force moved the fluid
     CHECK_THROWS_WITH(b.end_step(dt, in, ob), Catch::Contains("no step of this dt begun"));
     b.begin_step(dt);
+    CHECK_THROWS_WITH(b.redo_step(dt, in, ob), Catch::Contains("kept for a redo"));
     CHECK_THROWS_WITH(b.begin_step(dt), Catch::Contains("begun"));
     CHECK_THROWS_WITH(b.step(dt, in, ob), Catch::Contains("begun"));
   }
@@ -260,4 +262,33 @@ TEST_CASE("Crank-Nicolson with an immersed block keeps the explicit scheme's ste
   double diff = 0;
   for (int j = 0; j < 16; ++j) diff = std::max(diff, std::abs(steady[0](0, j) - steady[1](0, j)));
   CHECK(diff < 1e-11);
+}
+
+// Crank-Nicolson: the momentum the step gains is the integral of the f_s it returns (doubly
+// periodic box: neither walls nor the projection take momentum), on a step from a moving state.
+TEST_CASE("Crank-Nicolson: the momentum gained is the returned forcing", "[fluid][coupling]") {
+  Config c = box(BcType::periodic);
+  c.bc[bottom].type = c.bc[top].type = BcType::periodic;
+  c.implicit = true;
+  const double dt = 1e-3;
+  Solver s(c, dt);
+  const Grid& g = s.grid();
+  BlockInput block(s);
+  CouplingOut out;
+  for (int n = 0; n < 3; ++n) s.step(dt, block.in, out);
+  auto momentum = [&] {
+    double m = 0;
+    for (int j = 0; j < g.ny(); ++j)
+      for (int i = 0; i < g.nx(); ++i) m += c.density * s.u()(i, j) * g.x().h() * g.y().width(j);
+    return m;
+  };
+  const double before = momentum();
+  s.step(dt, block.in, out);
+  double fint = 0;
+  for (std::size_t q = 0; q < block.index.size(); ++q) {
+    const int j = block.index[q] / g.nu();
+    fint += out.solid_u_force[q] * g.x().h() * g.y().width(j);
+  }
+  CHECK(std::abs(fint) > 1e-3);
+  CHECK(momentum() - before == Approx(fint * dt).epsilon(1e-9));
 }
