@@ -179,6 +179,11 @@ Config read_config(const fsi::SceneTable& f, double dt) {
   c.density = f.positive("density");
   c.viscosity = f.positive("viscosity");
   c.implicit = f.choice("diffusion", {"explicit", "implicit"}, "explicit") == "implicit";
+  c.forcing_in_solve =
+      f.choice("immersed_forcing", {"after_solve", "in_solve"}, "after_solve") == "in_solve";
+  if (c.forcing_in_solve && !c.implicit)
+    f.fail("immersed_forcing", "\"in_solve\" needs diffusion = \"implicit\" (the explicit "
+                               "predictor has no solve)");
 
   const fsi::SceneTable g = f.table("grid");
   const std::vector<double> cells = g.numbers("cells");

@@ -58,6 +58,9 @@ struct Config {
   AxisSpec x, y;
   std::array<SideBc, 4> bc;  // left, right, bottom, top
   bool implicit = false;     // Crank-Nicolson diffusion (else explicit AB2)
+  // Crank-Nicolson: the immersed forcing inside the solve, from the explicit estimate (else on
+  // the solve's result; Solver::predictor_implicit).
+  bool forcing_in_solve = false;
   // Body force per unit volume f(t) = body + oscillating sin(2 pi t / period + phase) (Eq. 29
   // with body = 0), plus rho g.
   std::array<double, 2> body{0, 0}, oscillating{0, 0}, gravity{0, 0};

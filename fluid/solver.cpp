@@ -264,7 +264,7 @@ void Solver::redo_step(double dt, const CouplingIn& in, CouplingOut& out) {
 void Solver::finish_step(double dt, const CouplingIn& in, CouplingOut& out) {
   auto t0 = Clock::now();
   if (m_cfg.implicit) solve_implicit(dt, in, out);
-  else immersed_forcing(dt, in, out);
+  if (!m_cfg.forcing_in_solve) immersed_forcing(dt, in, out);
   m_time.predictor += since(t0);
 
   project(dt);
@@ -362,7 +362,7 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
 }
 
 // Crank-Nicolson predictor, theta = nu dt / 2:
-//   (I - theta L) u~ = B + dt f_s / rho,
+//   (I - theta L) u~ = B   (+ dt f_s / rho with the forcing in the solve, below),
 //   B  = u^n + dt [AB2(-div(u u)) - G p^n / rho + f / rho + f_f / rho] + theta L u^n
 //        + theta b^{n+1},
 // with b^{n+1} the boundary data at t^{n+1}. L is solved as the fast solver's L0, which equals L
@@ -371,19 +371,24 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
 // explicitly with u^n, so a steady state is that of L exactly; this is stable for
 // nu dt / h_t^2 < 2 (checked by validate()).
 //
-// The immersed solid's forcing enters the solve (solve_implicit), computed from the explicit
-// estimate
-//   u^ = u^n + dt [AB2(-div(u u)) - G p^n / rho + f / rho + f_f / rho] + 2 theta L u^n
-// (the paper's predictor, with the step's diffusion taken explicitly):
-//   f_s = rho alpha (u_s - u^) / dt.
-// At a steady state (u~ = u^n = u) the solve reads 0 = (u^ - u) + alpha (u_s - u^), i.e.
-// u = (1 - alpha) u^ + alpha u_s: the explicit scheme's balance, whatever theta. Forcing the
-// solve's result u~ after it instead lets the implicit term diffuse the unforced prediction
-// inside the body, and the wall the flow sees moves by lambda = nu dt / h^2 (runs/sub-cell-wall).
-// Inside the body (alpha = 1) u~ = u_s + theta L0 (u~ - u^n) (+ the change of the boundary data
-// over the step next to a wall): u_s up to the diffusion of the step's change, a soft constraint
-// for short modes at large lambda (the grid-scale mode of the step's change of u_s is missed by
-// a fraction 4 lambda / (1 + 4 lambda); smooth ones, a rigid motion, by far less).
+// The immersed solid's forcing (fluid.immersed_forcing):
+// - "after_solve" (default): on the solve's result, as the explicit scheme forces its predictor,
+//   u~ <- (1 - alpha) u~ + alpha u_s (immersed_forcing). The implicit term has then acted on the
+//   unforced prediction inside the body, and a steady wall is seen further inside it the larger
+//   lambda = nu dt / h^2 (runs/sub-cell-wall: 0.56, 0.71, 1.12 cells at lambda 0.128, 0.5, 2
+//   for a wall on a grid line, against half a cell with explicit diffusion).
+// - "in_solve": inside the solve (solve_implicit), from the explicit estimate
+//     u^ = u^n + dt [AB2(-div(u u)) - G p^n / rho + f / rho + f_f / rho] + 2 theta L u^n
+//   (the paper's predictor, with the step's diffusion taken explicitly):
+//     f_s = rho alpha (u_s - u^) / dt,   (I - theta L) u~ = B + dt f_s / rho.
+//   At a steady state (u~ = u^n = u; B - u^ = -theta L u^n + the boundary rows, which cancel
+//   against theta L u) the solve reads 0 = (u^ - u) + alpha (u_s - u^), i.e.
+//   u = (1 - alpha) u^ + alpha u_s: the explicit scheme's balance, whatever lambda (half a cell
+//   for a wall on a grid line). But the viscous stress of the fluid inside the body now reaches
+//   the solid through an explicit term (nu L u^n in u^): with the explicit coupling, the
+//   two-layer channel (rho_s = 2 rho_f) ran at lambda 0.128 and 0.51 and diverged at 2.05.
+//   Inside the body (alpha = 1) the solve gives u~ = u_s + theta L0 (u~ - u^n) (+ the change of
+//   the boundary data next to a wall): u_s up to the diffusion of the step's change.
 //
 // This assembles B (scaled by -1/theta, as the Helmholtz solver takes it) and u^, both in the
 // solver's layout, into m_rhs and m_hat; they are kept until the step is over (a redo of the
@@ -462,8 +467,10 @@ void Solver::predictor_implicit(double dt, double t_half) {
   }
 }
 
-// The Crank-Nicolson solve of the step (predictor_implicit): B + alpha (u_s - u^) on the solid's
-// faces, i.e. B + dt f_s / rho with f_s = rho alpha (u_s - u^) / dt, then u~ = (I - theta L)^-1.
+// The Crank-Nicolson solve of the step (predictor_implicit). With the forcing in the solve:
+// B + alpha (u_s - u^) on the solid's faces, i.e. B + dt f_s / rho with
+// f_s = rho alpha (u_s - u^) / dt, then u~ = (I - theta L)^-1 of it; else B alone (the forcing
+// follows on u~).
 void Solver::solve_implicit(double dt, const CouplingIn& in, CouplingOut& out) {
   const double rho = m_cfg.density;
   const double scale = -1.0 / (0.5 * m_nu * dt);
@@ -481,8 +488,8 @@ void Solver::solve_implicit(double dt, const CouplingIn& in, CouplingOut& out) {
     const auto& alpha = comp == 0 ? in.solid_u_alpha : in.solid_v_alpha;
     const auto& us = comp == 0 ? in.solid_u_velocity : in.solid_v_velocity;
     auto& force = comp == 0 ? out.solid_u_force : out.solid_v_force;
-    force.resize(idx.size());
-    for (std::size_t q = 0; q < idx.size(); ++q) {
+    if (m_cfg.forcing_in_solve) force.resize(idx.size());
+    for (std::size_t q = 0; m_cfg.forcing_in_solve && q < idx.size(); ++q) {
       const int i = comp == 0 ? int(idx[q] % nu) : int(idx[q] % nx);
       const int j = comp == 0 ? int(idx[q] / nu) : int(idx[q] / nx);
       double f = 0;

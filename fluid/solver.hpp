@@ -43,7 +43,8 @@ struct CouplingIn {
 // Output of one step:
 //   solid_*_force: f_s = rho_f alpha (u_s - u~) / dt on the solid's faces, in the input order,
 //                  force per unit volume ON THE FLUID (the solid receives its reaction);
-//                  Crank-Nicolson: u^, the explicit estimate, for u~ (predictor_implicit).
+//                  with the forcing in the Crank-Nicolson solve, u^, the explicit estimate,
+//                  for u~ (predictor_implicit).
 //   sample_*:      u^(n+1) on the requested faces, in the input order.
 struct CouplingOut {
   std::vector<double> solid_u_force, solid_v_force;
@@ -75,14 +76,14 @@ class Solver {
   void step(double dt, const CouplingIn& in, CouplingOut& out);
   // The same step in two parts, so that the first runs before the coupling input exists:
   // begin_step() does everything up to the predictor u~ without the fibers' force (Crank-Nicolson:
-  // up to its right-hand side); end_step() adds that force, then the immersed forcing (inside
-  // the Crank-Nicolson solve), projection and samples. Bit-identical to step(dt, in, out).
+  // up to its right-hand side); end_step() adds that force, then the Crank-Nicolson solve, the
+  // immersed forcing, projection and samples. Bit-identical to step(dt, in, out).
   void begin_step(double dt);
   void end_step(double dt, const CouplingIn& in, CouplingOut& out);
   // Coupled iterations: the step just taken again from its predictor u~ and p^n (kept by
   // step() while set_keep_for_redo(true), the default; Crank-Nicolson: from its kept right-hand
   // side and explicit estimate), with new solid input: immersed forcing (Crank-Nicolson: and
-  // its solve), projection, samples. The fibers' force and the predictor are not recomputed (in.fiber_* is
+  // its solve again), projection, samples. The fibers' force and the predictor are not recomputed (in.fiber_* is
   // ignored). dt must be that of the step.
   void redo_step(double dt, const CouplingIn& in, CouplingOut& out);
   // Whether step() keeps u~, v~ (Crank-Nicolson: the fields before its solve) and p^n for a redo

@@ -98,3 +98,14 @@ TEST_CASE("unknown keys are errors", "[fluid][config]") {
   CHECK_THROWS_WITH(read(replace(kGood, "viscosity = 0.01", "viscosity = 0.01\nviscocity = 2")),
                     Contains("viscocity"));
 }
+
+TEST_CASE("immersed_forcing: its two values, and in_solve only with Crank-Nicolson", "[fluid][config]") {
+  const std::string cn = replace(kGood, "viscosity = 0.01", "viscosity = 0.01\ndiffusion = \"implicit\"");
+  CHECK_FALSE(read(cn, 0.01).forcing_in_solve);
+  CHECK(read(replace(cn, "diffusion = \"implicit\"", "diffusion = \"implicit\"\nimmersed_forcing = \"in_solve\""), 0.01)
+            .forcing_in_solve);
+  CHECK_THROWS_WITH(read(replace(cn, "diffusion = \"implicit\"", "diffusion = \"implicit\"\nimmersed_forcing = \"inside\""), 0.01),
+                    Contains("immersed_forcing") && Contains("inside"));
+  CHECK_THROWS_WITH(read(replace(kGood, "viscosity = 0.01", "viscosity = 0.01\nimmersed_forcing = \"in_solve\""), 0.01),
+                    Contains("fluid.immersed_forcing") && Contains("needs diffusion = \"implicit\""));
+}
