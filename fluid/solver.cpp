@@ -339,12 +339,11 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
       const int ib = comp == 0 ? m_i0 : 0, jb = comp == 0 ? 0 : m_j0;
       const int nt = (comp == 0 ? m_helm_u : m_helm_v)->nt();
       for (std::size_t q = 0; q < idx.size(); ++q) {
-        const int i = comp == 0 ? int(idx[q] % nu) : int(idx[q] % nx);
-        const int j = comp == 0 ? int(idx[q] / nu) : int(idx[q] / nx);
+        const auto [i, j] = face_of(comp, idx[q]);
         if (i < ib || i >= nx || j < jb || j >= ny) continue;
         const int k = buf_index(i, j, ib, jb, nt);
         m_rhs[comp][k] += scale * dt * ri * frc[q];
-        m_hat[comp][k] += dt * ri * frc[q];
+        if (m_cfg.forcing_in_solve) m_hat[comp][k] += dt * ri * frc[q];
       }
     }
     return;
@@ -390,8 +389,8 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
 //   Inside the body (alpha = 1) the solve gives u~ = u_s + theta L0 (u~ - u^n) (+ the change of
 //   the boundary data next to a wall): u_s up to the diffusion of the step's change.
 //
-// This assembles B (scaled by -1/theta, as the Helmholtz solver takes it) and u^, both in the
-// solver's layout, into m_rhs and m_hat; they are kept until the step is over (a redo of the
+// This assembles B (scaled by -1/theta, as the Helmholtz solver takes it) and, with the forcing
+// in the solve, u^, both in the solver's layout, into m_rhs and m_hat; they are kept until the step is over (a redo of the
 // step solves again from them).
 void Solver::predictor_implicit(double dt, double t_half) {
   const double c1 = m_step == 0 ? 1.0 : 1.0 + 0.5 * dt / m_dt_prev;
@@ -413,8 +412,9 @@ void Solver::predictor_implicit(double dt, double t_half) {
     const int nt = hs.nt();
     std::vector<double>& buf = m_rhs[comp];
     std::vector<double>& hat = m_hat[comp];
+    const bool estimate = m_cfg.forcing_in_solve;  // u^ is needed only for the forcing in the solve
     buf.resize(std::size_t(hs.nt()) * hs.ns());
-    hat.resize(buf.size());
+    if (estimate) hat.resize(buf.size());
     const double* gd = comp == 0 ? X.di() : Y.di();
     for (int j = jb; j < ny; ++j) {
       const double* f = F.row(j);
@@ -428,7 +428,7 @@ void Solver::predictor_implicit(double dt, double t_half) {
         const double rhs = f[i] + dt * (c1 * h[i] + c0 * ho[i] + acc[comp] - ri * gp) + theta * l[i];
         const int k = buf_index(i, j, ib, jb, nt);
         buf[k] = scale * rhs;
-        hat[k] = rhs + theta * l[i];
+        if (estimate) hat[k] = rhs + theta * l[i];
       }
     }
     // Boundary rows: theta * coef * (value beyond the row at t^{n+1} - what the solved operator
@@ -474,7 +474,7 @@ void Solver::predictor_implicit(double dt, double t_half) {
 void Solver::solve_implicit(double dt, const CouplingIn& in, CouplingOut& out) {
   const double rho = m_cfg.density;
   const double scale = -1.0 / (0.5 * m_nu * dt);
-  const int nx = m_grid.nx(), ny = m_grid.ny(), nu = m_grid.nu();
+  const int nx = m_grid.nx(), ny = m_grid.ny();
   for (int comp = 0; comp < 2; ++comp) {
     Field& F = comp == 0 ? m_u : m_v;
     FastSolver& hs = comp == 0 ? *m_helm_u : *m_helm_v;
@@ -490,8 +490,7 @@ void Solver::solve_implicit(double dt, const CouplingIn& in, CouplingOut& out) {
     auto& force = comp == 0 ? out.solid_u_force : out.solid_v_force;
     if (m_cfg.forcing_in_solve) force.resize(idx.size());
     for (std::size_t q = 0; m_cfg.forcing_in_solve && q < idx.size(); ++q) {
-      const int i = comp == 0 ? int(idx[q] % nu) : int(idx[q] % nx);
-      const int j = comp == 0 ? int(idx[q] / nu) : int(idx[q] / nx);
+      const auto [i, j] = face_of(comp, idx[q]);
       double f = 0;
       if (i >= ib && i < nx && j >= jb && j < ny) {
         const int k = buf_index(i, j, ib, jb, nt);

@@ -124,6 +124,11 @@ class Solver {
   void immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out);
   void project(double dt);
   void finish_step(double dt, const CouplingIn& in, CouplingOut& out);
+  // (i, j) of the face with the coupling index idx, of u (comp 0) or v (comp 1).
+  std::array<int, 2> face_of(int comp, std::int32_t idx) const {
+    const int w = comp == 0 ? m_grid.nu() : m_grid.nx();
+    return {int(idx % w), int(idx / w)};
+  }
   int buf_index(int i, int j, int i_first, int j_first, int nt) const {
     return m_t_axis == 0 ? (i - i_first) + nt * (j - j_first) : (j - j_first) + nt * (i - i_first);
   }
