@@ -384,8 +384,20 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
 //   against theta L u) the solve reads 0 = (u^ - u) + alpha (u_s - u^), i.e.
 //   u = (1 - alpha) u^ + alpha u_s: the explicit scheme's balance, whatever lambda (half a cell
 //   for a wall on a grid line). But the viscous stress of the fluid inside the body now reaches
-//   the solid through an explicit term (nu L u^n in u^): with the explicit coupling, the
-//   two-layer channel (rho_s = 2 rho_f) ran at lambda 0.128 and 0.51 and diverged at 2.05.
+//   the solid through an explicit term (nu L u^n in u^). With the explicit coupling this limits
+//   lambda. Model: one mode of L (eigenvalue -kappa / h^2, c = kappa lambda) in a covered region
+//   (alpha = 1), fluid velocity u, solid velocity v, FE inertia rho_s - rho_f (the fluid inside
+//   carries rho_f), r = rho_f / (rho_s - rho_f), the solid's stiffness left out:
+//     fluid:  (1 + c/2) u' = (1 - c/2) u + (v - u^),  u^ = (1 - c) u,  so u' = (v + c u / 2) / (1 + c/2);
+//     solid:  v' = v - r (v - u^)   (the reaction -rho_f (v - u^) / dt).
+//   Jury's conditions for this 2 x 2 map: det = (c + c r - 2 r) / (2 + c) < 1, i.e.
+//   c < 2 + 2 / r = 2 rho_s / rho_f, and r < 1 + c (at c = 0 the explicit coupling's own
+//   rho_s > 2 rho_f). So lambda < 2 rho_s / (kappa rho_f): rho_s / (4 rho_f) for any mode of the
+//   2D grid (kappa <= 8), rho_s / (2 rho_f) for a shear across a layer (kappa <= 4). Measured
+//   (runs/two-layer-channel, runs/wavy-channel): every run that failed was above the 2D bound
+//   and none below it failed. (With the forcing after the solve the same model has u' = v and
+//   u~ = u (2 - c) / (2 + c) in the reaction: stable for every c when r < 1, no limit on
+//   lambda.) Coupled iterations make the exchange implicit and lift the limit.
 //   Inside the body (alpha = 1) the solve gives u~ = u_s + theta L0 (u~ - u^n) (+ the change of
 //   the boundary data next to a wall): u_s up to the diffusion of the step's change.
 //
