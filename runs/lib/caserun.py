@@ -16,6 +16,20 @@ BIN = os.environ.get("FSI_BIN", os.path.join(ROOT, "build", "bin"))
 OUT = os.environ.get("FSI_OUT", os.path.join(os.getcwd(), "out"))
 SHORT = "--short" in sys.argv
 
+# Coupled iterations for the layer cases (two-layer channel, equal densities, wavy channel;
+# coupler/README.md). relaxation: the first iteration of a step (before IQN-ILS has columns) must
+# not overshoot the slowest mode, amplified about 1/(omega_1 dt)^2 ~ 1e4-1e5 times at
+# rho_s = rho_f (runs/equal-density/README.md); with 0.5 the 32-cell channel diverged in its
+# first steps. reuse: the map changes little from step to step.
+COUPLED_ITERATIONS = """[coupler]
+[coupler.iterations]
+max = 30
+tolerance = 1e-6
+acceleration = "iqn-ils"
+relaxation = 1e-4
+reuse = 20
+"""
+
 
 def run_program(program, name, scene_text, expect_error=False):
     """Write OUT/name.toml, run `program` on it into OUT/name; return (folder, wall seconds).
