@@ -45,6 +45,11 @@ double explicit_diffusion_limit(const Config& c) {
   return 1.0 / (4.0 * nu * (1.0 / (hx * hx) + 1.0 / (hy * hy)));
 }
 
+double in_solve_density_bound(const Config& c, double dt) {
+  const double hx = min_width(c.x), hy = min_width(c.y);
+  return 2.0 * c.viscosity * dt * (1.0 / (hx * hx) + 1.0 / (hy * hy));
+}
+
 void validate(const Config& c, double dt) {
   if (!(c.density > 0)) bad(c, fmt::format("fluid.density must be > 0, got {}", c.density));
   if (!(c.viscosity > 0)) bad(c, fmt::format("fluid.viscosity must be > 0, got {}", c.viscosity));

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "diagnostics.hpp"
 
@@ -84,6 +85,7 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
   c.sample_u_index = in.sample_u;
   c.sample_v_index = in.sample_v;
   if (s.iteration == 0) {
+    warn_in_solve(s, in);
     m_solver->set_keep_for_redo(s.may_repeat != 0);
     if (m_begun) m_solver->end_step(s.dt, c, m_out);
     else m_solver->step(s.dt, c, m_out);
@@ -99,6 +101,22 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
   out.cfl = m_cfl;
   out.max_div = m_div;
   out.kinetic_energy = m_energy;
+}
+
+void FluidProgram::warn_in_solve(const fsi::proto::StepBegin& s, const fsi::proto::FluidInput& in) {
+  if (m_warned_in_solve || !m_cfg.implicit || !m_cfg.forcing_in_solve || s.may_repeat != 0) return;
+  if (in.solid_u.index.empty() && in.solid_v.index.empty()) return;
+  m_warned_in_solve = true;
+  // The explicit coupling needs rho_s > 2 rho_f in any case (coupler/README.md); say nothing
+  // when the forcing's bound is not the tighter one.
+  const double bound = in_solve_density_bound(m_cfg, s.dt);
+  if (bound <= 2.0 * m_cfg.density) return;
+  fmt::print(stderr,
+             "[fluid] WARNING: fluid.immersed_forcing = \"in_solve\" with the explicit coupling "
+             "holds an elastic body only if its density is at least {:.3g} (2 rho_f nu dt "
+             "(1/dx^2 + 1/dy^2) at dt = {:g}): a lighter body can grow a mode that does not stop "
+             "the run; add [coupler.iterations] or lower time.dt (fluid/README.md)\n",
+             bound, s.dt);
 }
 
 void FluidProgram::check_health(long step, double t, double dt) {
