@@ -107,15 +107,17 @@ void FluidProgram::warn_in_solve(const fsi::proto::StepBegin& s, const fsi::prot
   if (m_warned_in_solve || !m_cfg.implicit || !m_cfg.forcing_in_solve || s.may_repeat != 0) return;
   if (in.solid_u.index.empty() && in.solid_v.index.empty()) return;
   m_warned_in_solve = true;
-  // The explicit coupling needs rho_s > 2 rho_f in any case (coupler/README.md); say nothing
-  // when the forcing's bound is not the tighter one.
+  // The explicit coupling needs rho_s > 2 rho_f in any case (coupler/README.md); say nothing when
+  // every such body is well above the forcing's bound (a margin of 1.25: the wavy channel failed
+  // with a body 1.06 times as dense as the bound, runs/wavy-channel).
   const double bound = in_solve_density_bound(m_cfg, s.dt);
-  if (bound <= 2.0 * m_cfg.density) return;
+  if (1.25 * bound <= 2.0 * m_cfg.density) return;
   fmt::print(stderr,
              "[fluid] WARNING: fluid.immersed_forcing = \"in_solve\" with the explicit coupling "
-             "holds an elastic body only if its density is at least {:.3g} (2 rho_f nu dt "
-             "(1/dx^2 + 1/dy^2) at dt = {:g}): a lighter body can grow a mode that does not stop "
-             "the run; add [coupler.iterations] or lower time.dt (fluid/README.md)\n",
+             "needs an elastic body's density well above {:.3g} (a model's bound, 2 rho_f nu dt "
+             "(1/dx^2 + 1/dy^2) at dt = {:g}, and a body 1.06 times as dense failed): a lighter "
+             "body can grow a mode that does not stop the run. Add [coupler.iterations] or lower "
+             "time.dt (fluid/README.md)\n",
              bound, s.dt);
 }
 

@@ -31,7 +31,7 @@ class FluidProgram : public fsi::FluidPort {
   // Health: NaN/Inf, CFL above its limit, divergence growth. Writes the state, then throws.
   void check_health(long step, double t, double dt);
   // With the forcing inside the Crank-Nicolson solve and the explicit coupling (no coupled
-  // iterations), say once which elastic bodies the coupling holds (in_solve_density_bound).
+  // iterations), say once which elastic bodies the coupling may not hold (in_solve_density_bound).
   void warn_in_solve(const fsi::proto::StepBegin& s, const fsi::proto::FluidInput& in);
 
   fsi::Runtime& m_rt;

@@ -392,12 +392,16 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
 //     solid:  v' = v - r (v - u^)   (the reaction -rho_f (v - u^) / dt).
 //   Jury's conditions for this 2 x 2 map: det = (c + c r - 2 r) / (2 + c) < 1, i.e.
 //   c < 2 + 2 / r = 2 rho_s / rho_f, and r < 1 + c (at c = 0 the explicit coupling's own
-//   rho_s > 2 rho_f). So lambda < 2 rho_s / (kappa rho_f): rho_s / (4 rho_f) for any mode of the
-//   2D grid (kappa <= 8), rho_s / (2 rho_f) for a shear across a layer (kappa <= 4). Measured
-//   (runs/two-layer-channel, runs/wavy-channel): every run that failed was above the 2D bound
-//   and none below it failed. (With the forcing after the solve the same model has u' = v and
-//   u~ = u (2 - c) / (2 + c) in the reaction: stable for every c when r < 1, no limit on
-//   lambda.) Coupled iterations make the exchange implicit and lift the limit.
+//   rho_s > 2 rho_f). So lambda < 2 rho_s / (kappa rho_f); with kappa / h^2 <= 4 / dx^2 + 4 / dy^2
+//   for the modes of the grid, rho_s > 2 rho_f nu dt (1/dx^2 + 1/dy^2) (in_solve_density_bound;
+//   lambda < rho_s / (4 rho_f) on square cells), and lambda < rho_s / (2 rho_f) for a pure shear
+//   across a layer (kappa <= 4). Measured (runs/two-layer-channel, runs/wavy-channel): the
+//   two-layer channel's failures all lie above the bound, and its shear held at a lambda 1.6
+//   times the bound's; the wavy channel failed with rho_s 1.06 times the bound, so the model (no
+//   pressure, no solid mesh) is not a sufficient condition. (With the forcing after the solve
+//   the same model has u' = v and u~ = u (2 - c) / (2 + c) in the reaction: stable for every c
+//   when r < 1, no limit on lambda.) Coupled iterations make the exchange implicit and lift the
+//   limit.
 //   Inside the body (alpha = 1) the solve gives u~ = u_s + theta L0 (u~ - u^n) (+ the change of
 //   the boundary data next to a wall): u_s up to the diffusion of the step's change.
 //
