@@ -86,11 +86,12 @@ void validate(const Config& c, double dt);
 // Largest dt of explicit AB2 diffusion: 1 / (4 nu (1/dx_min^2 + 1/dy_min^2)).
 double explicit_diffusion_limit(const Config& c);
 
-// Smallest density of an elastic body that the explicit staggered coupling holds with the
-// forcing inside the Crank-Nicolson solve (immersed_forcing = "in_solve"): the model above
-// Solver::predictor_implicit asks nu dt kappa / h^2 < 2 rho_s / rho_f for every grid mode, and
-// kappa / h^2 <= 4 (1/dx_min^2 + 1/dy_min^2), so rho_s >= 2 rho_f nu dt (1/dx_min^2 + 1/dy_min^2)
-// (4 lambda rho_f on a uniform square grid).
+// The density an elastic body needs, by the two-mode model above Solver::predictor_implicit,
+// for the explicit staggered coupling to hold it with the forcing inside the Crank-Nicolson
+// solve (immersed_forcing = "in_solve"): the model asks nu dt kappa / h^2 < 2 rho_s / rho_f for
+// every grid mode, and kappa / h^2 <= 4 (1/dx_min^2 + 1/dy_min^2), so
+// rho_s > 2 rho_f nu dt (1/dx_min^2 + 1/dy_min^2) (4 lambda rho_f on a uniform square grid).
+// Necessary in the model, not sufficient in practice (fluid/README.md).
 double in_solve_density_bound(const Config& c, double dt);
 
 }  // namespace fluid
