@@ -31,6 +31,15 @@ reuse = 20
 """
 
 
+def iterations_per_step(folder):
+    """Mean coupled iterations per step of a run (its coupler_iterations.csv), None when the run
+    had no coupled iterations."""
+    path = os.path.join(folder, "coupler_iterations.csv")
+    if not os.path.exists(path):
+        return None
+    return float(np.mean(np.genfromtxt(path, delimiter=",", names=True)["iterations"]))
+
+
 def run_program(program, name, scene_text, expect_error=False):
     """Write OUT/name.toml, run `program` on it into OUT/name; return (folder, wall seconds).
     With expect_error, require a failure and return the program's output instead."""
