@@ -192,28 +192,53 @@ void ImmersedSolid::clip_body(const FaceBoxes& boxes, const EdgeIndex& ix, const
   }
 }
 
-// The touched faces (sorted) and each piece's slot among them; the area of each face.
-void ImmersedSolid::gather(const Raw& fixed, const Raw& moving, Faces& p, Scratch& s) {
+// Once, after the fixed bodies are clipped: their faces (sorted), each face's area and each
+// piece's index among those faces.
+void ImmersedSolid::index_fixed(Fixed& f, Scratch& s) {
+  auto& slot = s.slot;
+  f.face.clear();
+  for (const Piece& q : f.raw)
+    if (slot[q.face] < 0) slot[q.face] = 0, f.face.push_back(q.face);
+  std::sort(f.face.begin(), f.face.end());
+  for (std::size_t k = 0; k < f.face.size(); ++k) slot[f.face[k]] = static_cast<std::int32_t>(k);
+  f.area.assign(f.face.size(), 0.0);
+  f.local.resize(f.raw.size());
+  for (std::size_t e = 0; e < f.raw.size(); ++e) {
+    const Piece& q = f.raw[e];
+    f.local[e] = slot[q.face];
+    f.area[f.local[e]] += q.w[0] + q.w[1] + q.w[2];
+  }
+  for (const std::int32_t face : f.face) slot[face] = -1;
+  f.slot.assign(f.face.size(), -1);
+}
+
+// The touched faces (sorted): the moving bodies' faces, sorted, merged with the fixed bodies'
+// (sorted once); each moving piece's slot and each fixed face's slot; the area of each face.
+void ImmersedSolid::gather(Fixed& fixed, const Raw& moving, Faces& p, Scratch& s) {
   auto& slot = s.slot;
   p.fixed = &fixed;
   p.moving = &moving;
-  p.face.clear();
-  for (const Raw* r : {&fixed, &moving})
-    for (const Piece& q : *r)
-      if (slot[q.face] < 0) slot[q.face] = 0, p.face.push_back(q.face);
-  std::sort(p.face.begin(), p.face.end());
+  auto& mf = p.moving_face;
+  mf.clear();
+  for (const Piece& q : moving)
+    if (slot[q.face] < 0) slot[q.face] = 0, mf.push_back(q.face);
+  std::sort(mf.begin(), mf.end());
+  p.face.resize(mf.size() + fixed.face.size());
+  p.face.erase(std::set_union(mf.begin(), mf.end(), fixed.face.begin(), fixed.face.end(),
+                              p.face.begin()),
+               p.face.end());
   const std::size_t nf = p.face.size();
   for (std::size_t k = 0; k < nf; ++k) slot[p.face[k]] = static_cast<std::int32_t>(k);
   p.area.assign(nf, 0.0);
-  auto slots = [&](const Raw& r, std::vector<std::int32_t>& out) {
-    out.resize(r.size());
-    for (std::size_t e = 0; e < r.size(); ++e) {
-      out[e] = slot[r[e].face];
-      p.area[out[e]] += r[e].w[0] + r[e].w[1] + r[e].w[2];
-    }
-  };
-  slots(fixed, p.slot_fixed);
-  slots(moving, p.slot_moving);
+  for (std::size_t m = 0; m < fixed.face.size(); ++m) {
+    fixed.slot[m] = slot[fixed.face[m]];
+    p.area[fixed.slot[m]] += fixed.area[m];
+  }
+  p.slot_moving.resize(moving.size());
+  for (std::size_t e = 0; e < moving.size(); ++e) {
+    p.slot_moving[e] = slot[moving[e].face];
+    p.area[p.slot_moving[e]] += moving[e].w[0] + moving[e].w[1] + moving[e].w[2];
+  }
   p.total_area = 0;
   for (std::size_t k = 0; k < nf; ++k) {
     p.total_area += p.area[k];
@@ -225,12 +250,20 @@ void ImmersedSolid::fill(const FaceBoxes& boxes, const Faces& p, const proto::So
                          int component, proto::FaceSolid& out) const {
   const std::size_t nf = p.face.size();
   p.sum.assign(nf, 0.0);
-  for (const auto& [r, slot] : {std::pair{p.fixed, &p.slot_fixed}, std::pair{p.moving, &p.slot_moving}})
-    for (std::size_t e = 0; e < r->size(); ++e) {
-      const Piece& q = (*r)[e];
-      const double* v = state.v[q.body].data() + component;
-      p.sum[(*slot)[e]] += q.w[0] * v[2 * q.node[0]] + q.w[1] * v[2 * q.node[1]] + q.w[2] * v[2 * q.node[2]];
-    }
+  auto add = [&](const Piece& q, std::int32_t slot) {
+    const double* v = state.v[q.body].data() + component;
+    p.sum[slot] += q.w[0] * v[2 * q.node[0]] + q.w[1] * v[2 * q.node[1]] + q.w[2] * v[2 * q.node[2]];
+  };
+  // A fixed body's pieces add nothing while its nodes are at rest, which is what a fixed body's
+  // state says; they are summed should it say otherwise.
+  bool fixed_at_rest = true;
+  for (std::size_t b = 0; b < m_meshes.bodies.size() && fixed_at_rest; ++b)
+    if (m_meshes.bodies[b].kind == 1)
+      for (const double vb : state.v[b]) fixed_at_rest = fixed_at_rest && vb == 0.0;
+  if (!fixed_at_rest)
+    for (std::size_t e = 0; e < p.fixed->raw.size(); ++e)
+      add(p.fixed->raw[e], p.fixed->slot[p.fixed->local[e]]);
+  for (std::size_t e = 0; e < p.moving->size(); ++e) add((*p.moving)[e], p.slot_moving[e]);
   out.index = p.face;
   out.alpha.resize(nf);
   out.velocity.resize(nf);
@@ -248,11 +281,13 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
   // The two families are independent (own boxes, pieces and scratch): the v-family runs on a
   // second thread while this one does the u-family. The solid waits meanwhile; the fluid runs its
   // predictor ahead of its input (one core's worth of work).
-  auto family = [&](const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy, Raw& fixed,
+  auto family = [&](const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy, Fixed& fixed,
                     Raw& raw, Faces& p, Scratch& s, int c, proto::FaceSolid& out) {
-    if (!m_fixed_done)
+    if (!m_fixed_done) {
       for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
-        if (bodies[b].kind == 1) clip_body(boxes, ix, iy, b, state.x[b], fixed);
+        if (bodies[b].kind == 1) clip_body(boxes, ix, iy, b, state.x[b], fixed.raw);
+      index_fixed(fixed, s);
+    }
     raw.clear();
     for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
       if (bodies[b].kind != 1) clip_body(boxes, ix, iy, b, state.x[b], raw);
@@ -292,14 +327,14 @@ void ImmersedSolid::reaction(const std::vector<double>& fs_u, const std::vector<
       const int i = p.face[k] % boxes.ni, j = p.face[k] / boxes.ni;
       p.sum[k] = -fs[k] * boxes.volume(i, j) / p.area[k];
     }
-    for (const auto& [r, slot] :
-         {std::pair{p.fixed, &p.slot_fixed}, std::pair{p.moving, &p.slot_moving}})
-      for (std::size_t e = 0; e < r->size(); ++e) {
-        const Piece& q = (*r)[e];
-        const double s = p.sum[(*slot)[e]];
-        double* f = force[q.body].data() + c;
-        for (int k = 0; k < 3; ++k) f[2 * q.node[k]] += s * q.w[k];
-      }
+    auto spread = [&](const Piece& q, double s) {
+      double* f = force[q.body].data() + c;
+      for (int k = 0; k < 3; ++k) f[2 * q.node[k]] += s * q.w[k];
+    };
+    for (std::size_t e = 0; e < p.fixed->raw.size(); ++e)
+      spread(p.fixed->raw[e], p.sum[p.fixed->slot[p.fixed->local[e]]]);
+    for (std::size_t e = 0; e < p.moving->size(); ++e)
+      spread((*p.moving)[e], p.sum[p.slot_moving[e]]);
   };
   add(m_ub, m_u, fs_u, 0);
   add(m_vb, m_v, fs_v, 1);

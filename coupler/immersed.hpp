@@ -104,31 +104,42 @@ class ImmersedSolid {
     double w[3];
   };
   using Raw = std::vector<Piece>;
-  // The touched faces of one family (sorted by index) and, for the pieces of the fixed and the
-  // moving bodies' lists, the slot of each piece's face: per-face sums are then one pass over
-  // the pieces into slot-indexed arrays, with no reordering of the pieces.
+  // The rigid fixed bodies' pieces of one family, clipped once, and what never changes about
+  // them: their faces (sorted), each face's area Σ |V ∩ T| and each piece's index among them.
+  // Each step then handles them per face, not per piece (slot: the face's slot this step).
+  struct Fixed {
+    Raw raw;
+    std::vector<std::int32_t> face, local, slot;
+    std::vector<double> area;
+  };
+  // The touched faces of one family (sorted by index) and, for the moving bodies' pieces, the
+  // slot of each piece's face: per-face sums are then one pass over the pieces into
+  // slot-indexed arrays, with no reordering of the pieces.
   struct Faces {
     std::vector<std::int32_t> face;
     std::vector<double> area;            // Σ |V ∩ T| of the face
-    std::vector<std::int32_t> slot_fixed, slot_moving;
-    const Raw* fixed = nullptr;
+    std::vector<std::int32_t> slot_moving;
+    const Fixed* fixed = nullptr;
     const Raw* moving = nullptr;
     double total_area = 0;
     mutable std::vector<double> sum;     // scratch: per-face sums in fill() and reaction()
+    std::vector<std::int32_t> moving_face;  // scratch of gather(): the moving bodies' faces
   };
   void clip_body(const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy, int b,
                  const std::vector<double>& x, Raw& raw) const;
   struct Scratch {  // per face of a family: -1, or its slot while gather() runs
     std::vector<std::int32_t> slot;
   };
-  void gather(const Raw& fixed, const Raw& moving, Faces& p, Scratch& s);
+  static void index_fixed(Fixed& f, Scratch& s);
+  void gather(Fixed& fixed, const Raw& moving, Faces& p, Scratch& s);
   void fill(const FaceBoxes& boxes, const Faces& p, const proto::SolidState& state, int component,
             proto::FaceSolid& out) const;
 
   const proto::BodyMeshes& m_meshes;
   FaceBoxes m_ub, m_vb;
   EdgeIndex m_ux, m_uy, m_vx, m_vy;  // box lookup of each family
-  Raw m_fixed_u, m_fixed_v, m_raw_u, m_raw_v;  // rigid fixed bodies' pieces, clipped once
+  Fixed m_fixed_u, m_fixed_v;  // rigid fixed bodies' pieces, clipped once
+  Raw m_raw_u, m_raw_v;
   bool m_fixed_done = false;
   Faces m_u, m_v;
   Scratch m_scratch_u, m_scratch_v;
