@@ -209,12 +209,11 @@ void ImmersedSolid::index_fixed(Fixed& f, Scratch& s) {
     f.area[f.local[e]] += q.w[0] + q.w[1] + q.w[2];
   }
   for (const std::int32_t face : f.face) slot[face] = -1;
-  f.slot.assign(f.face.size(), -1);
 }
 
 // The touched faces (sorted): the moving bodies' faces, sorted, merged with the fixed bodies'
 // (sorted once); each moving piece's slot and each fixed face's slot; the area of each face.
-void ImmersedSolid::gather(Fixed& fixed, const Raw& moving, Faces& p, Scratch& s) {
+void ImmersedSolid::gather(const Fixed& fixed, const Raw& moving, Faces& p, Scratch& s) {
   auto& slot = s.slot;
   p.fixed = &fixed;
   p.moving = &moving;
@@ -230,9 +229,10 @@ void ImmersedSolid::gather(Fixed& fixed, const Raw& moving, Faces& p, Scratch& s
   const std::size_t nf = p.face.size();
   for (std::size_t k = 0; k < nf; ++k) slot[p.face[k]] = static_cast<std::int32_t>(k);
   p.area.assign(nf, 0.0);
+  p.slot_fixed_face.resize(fixed.face.size());
   for (std::size_t m = 0; m < fixed.face.size(); ++m) {
-    fixed.slot[m] = slot[fixed.face[m]];
-    p.area[fixed.slot[m]] += fixed.area[m];
+    p.slot_fixed_face[m] = slot[fixed.face[m]];
+    p.area[p.slot_fixed_face[m]] += fixed.area[m];
   }
   p.slot_moving.resize(moving.size());
   for (std::size_t e = 0; e < moving.size(); ++e) {
@@ -262,7 +262,7 @@ void ImmersedSolid::fill(const FaceBoxes& boxes, const Faces& p, const proto::So
       for (const double vb : state.v[b]) fixed_at_rest = fixed_at_rest && vb == 0.0;
   if (!fixed_at_rest)
     for (std::size_t e = 0; e < p.fixed->raw.size(); ++e)
-      add(p.fixed->raw[e], p.fixed->slot[p.fixed->local[e]]);
+      add(p.fixed->raw[e], p.slot_fixed_face[p.fixed->local[e]]);
   for (std::size_t e = 0; e < p.moving->size(); ++e) add((*p.moving)[e], p.slot_moving[e]);
   out.index = p.face;
   out.alpha.resize(nf);
@@ -332,7 +332,7 @@ void ImmersedSolid::reaction(const std::vector<double>& fs_u, const std::vector<
       for (int k = 0; k < 3; ++k) f[2 * q.node[k]] += s * q.w[k];
     };
     for (std::size_t e = 0; e < p.fixed->raw.size(); ++e)
-      spread(p.fixed->raw[e], p.sum[p.fixed->slot[p.fixed->local[e]]]);
+      spread(p.fixed->raw[e], p.sum[p.slot_fixed_face[p.fixed->local[e]]]);
     for (std::size_t e = 0; e < p.moving->size(); ++e)
       spread((*p.moving)[e], p.sum[p.slot_moving[e]]);
   };

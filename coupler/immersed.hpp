@@ -105,20 +105,21 @@ class ImmersedSolid {
   };
   using Raw = std::vector<Piece>;
   // The rigid fixed bodies' pieces of one family, clipped once, and what never changes about
-  // them: their faces (sorted), each face's area Σ |V ∩ T| and each piece's index among them.
-  // Each step then handles them per face, not per piece (slot: the face's slot this step).
+  // them: their faces (sorted), each face's fixed-body area Σ_fixed |V ∩ T| and each piece's
+  // index among those faces. Each step then handles them per face, not per piece.
   struct Fixed {
     Raw raw;
-    std::vector<std::int32_t> face, local, slot;
+    std::vector<std::int32_t> face, local;
     std::vector<double> area;
   };
-  // The touched faces of one family (sorted by index) and, for the moving bodies' pieces, the
-  // slot of each piece's face: per-face sums are then one pass over the pieces into
-  // slot-indexed arrays, with no reordering of the pieces.
+  // The touched faces of one family (sorted by index), the slot of each moving piece's face and
+  // of each fixed face: per-face sums are then one pass over the pieces into slot-indexed
+  // arrays, with no reordering of the pieces.
   struct Faces {
     std::vector<std::int32_t> face;
     std::vector<double> area;            // Σ |V ∩ T| of the face
     std::vector<std::int32_t> slot_moving;
+    std::vector<std::int32_t> slot_fixed_face;  // per face of Fixed::face
     const Fixed* fixed = nullptr;
     const Raw* moving = nullptr;
     double total_area = 0;
@@ -127,11 +128,11 @@ class ImmersedSolid {
   };
   void clip_body(const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy, int b,
                  const std::vector<double>& x, Raw& raw) const;
-  struct Scratch {  // per face of a family: -1, or its slot while gather() runs
+  struct Scratch {  // per face of a family: -1, or its slot while gather() or index_fixed() runs
     std::vector<std::int32_t> slot;
   };
   static void index_fixed(Fixed& f, Scratch& s);
-  void gather(Fixed& fixed, const Raw& moving, Faces& p, Scratch& s);
+  void gather(const Fixed& fixed, const Raw& moving, Faces& p, Scratch& s);
   void fill(const FaceBoxes& boxes, const Faces& p, const proto::SolidState& state, int component,
             proto::FaceSolid& out) const;
 

@@ -265,3 +265,53 @@ TEST_CASE("the nodal reaction cancels the fluid forcing: action = reaction") {
     CHECK(std::abs(fy) <= 1e-12 * scale);
   }
 }
+
+// A rigid fixed body is clipped once and handled per face afterwards; its transfers must be
+// those of the same body clipped every step, to the bit: the faces, α, ū_s and the reaction,
+// with the body at rest (its pieces then add nothing to ū_s) and moving (a state a fixed body
+// does not send, summed all the same), through update() and update_velocities().
+TEST_CASE("a fixed body's transfers are those of the same body clipped every step") {
+  const auto g = grid(32, 32, 1.0, 1.0, true, false);
+  proto::BodyMeshes clipped_each_step;
+  double area = 0;
+  // The disk first: its pieces then come first in both runs, so every sum runs in one order.
+  clipped_each_step.bodies.push_back(disk(0.12, 4, {0.45, 0.45}, &area));
+  clipped_each_step.bodies.push_back(rectangle(0.3, 0.2, 8, 5, 0.3, {0.62, 0.5}));  // overlaps it
+  proto::BodyMeshes fixed = clipped_each_step;
+  fixed.bodies[0].kind = 1;
+  ImmersedSolid a(g, clipped_each_step), b(g, fixed);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> r(-1, 1);
+  auto s = at_rest(clipped_each_step);
+  auto same = [](const proto::FaceSolid& p, const proto::FaceSolid& q) {
+    CHECK(p.index == q.index);
+    CHECK(p.alpha == q.alpha);
+    CHECK(p.velocity == q.velocity);
+  };
+  for (int step = 0; step < 3; ++step) {
+    for (double& x : s.x[1]) x += 0.01 * r(rng);
+    for (double& v : s.v[1]) v = r(rng);
+    if (step == 2)
+      for (double& v : s.v[0]) v = r(rng);
+    proto::FaceSolid ua, va, ub, vb;
+    a.update(s, ua, va);
+    b.update(s, ub, vb);
+    same(ua, ub);
+    same(va, vb);
+    for (double& v : s.v[0]) v = step == 1 ? r(rng) : 0.0;
+    for (double& v : s.v[1]) v = r(rng);
+    a.update_velocities(s, ua, va);
+    b.update_velocities(s, ub, vb);
+    same(ua, ub);
+    same(va, vb);
+    std::vector<double> fs_u(ua.index.size()), fs_v(va.index.size());
+    for (auto& x : fs_u) x = 1000 * r(rng);
+    for (auto& x : fs_v) x = 1000 * r(rng);
+    std::vector<std::vector<double>> fa, fb;
+    a.reaction(fs_u, fs_v, fa);
+    b.reaction(fs_u, fs_v, fb);
+    CHECK(fa == fb);
+    CHECK(a.area_u() == b.area_u());
+    CHECK(a.area_v() == b.area_v());
+  }
+}
