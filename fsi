@@ -261,7 +261,7 @@ print("  the coupler alone with a 50 us sleep cap (the hub picks its answers up 
       " messages 1.1 -> 0.8 ms but the whole step no shorter (15.6-16.0 against 14.5-16.4 ms) and the"
       " default scene slower (3.9-5.7 against 3.4-4.2 ms): not kept")
 print("  fixed bodies (the cylinder) handled per face, not per piece, after their one clipping | -0.3 ms"
-      " footprint | footprint 1.41-2.41 -> 1.13-1.68 ms, coupler work + traffic / fluid step 0.22-0.33"
+      " footprint | footprint 1.40-2.41 -> 1.13-1.68 ms, coupler work + traffic / fluid step 0.22-0.33"
       " -> 0.19-0.26 (nine interleaved pairs); whole step within noise (12.1-15.8 against 12.1-15.1 ms)")
 print("  work ahead on a thread of its own at nice 19 (so a waking coupler gets a core at once) |"
       " -1 ms messages | worse: 18.2-22.7 ms (messages 2.1-3.3: the fluid's predictor starved beside"

@@ -161,7 +161,8 @@ int main(int argc, char** argv) {
   std::printf("  fixed bodies' faces and areas kept from their one clipping, merged per face each "
               "step (was: their pieces gathered and summed every step) | the cylinder's -0.3 ms | "
               "CPU with the cylinder 2.25-2.56 -> 2.18-2.22 ms, bar alone unchanged (1.98-2.12 "
-              "against 1.92-2.15; interleaved, machine loaded); results identical to the bit\n");
+              "against 1.92-2.15; the cylinder's share 0.14-0.49 -> 0.03-0.30 ms; three "
+              "interleaved pairs, machine loaded); results identical to the bit\n");
   if (out) {
     if (FILE* f = std::fopen(out, "w")) {
       auto fields = [&](const Result& r) {
