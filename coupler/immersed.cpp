@@ -192,14 +192,21 @@ void ImmersedSolid::clip_body(const FaceBoxes& boxes, const EdgeIndex& ix, const
   }
 }
 
+// The faces the pieces touch, each once, sorted. `slot` (per face: -1) marks them with 0; the
+// caller sets their slots and resets them.
+void ImmersedSolid::touched_faces(const Raw& raw, std::vector<std::int32_t>& slot,
+                                  std::vector<std::int32_t>& face) {
+  face.clear();
+  for (const Piece& q : raw)
+    if (slot[q.face] < 0) slot[q.face] = 0, face.push_back(q.face);
+  std::sort(face.begin(), face.end());
+}
+
 // Once, after the fixed bodies are clipped: their faces (sorted), each face's area and each
 // piece's index among those faces.
 void ImmersedSolid::index_fixed(Fixed& f, Scratch& s) {
   auto& slot = s.slot;
-  f.face.clear();
-  for (const Piece& q : f.raw)
-    if (slot[q.face] < 0) slot[q.face] = 0, f.face.push_back(q.face);
-  std::sort(f.face.begin(), f.face.end());
+  touched_faces(f.raw, slot, f.face);
   for (std::size_t k = 0; k < f.face.size(); ++k) slot[f.face[k]] = static_cast<std::int32_t>(k);
   f.area.assign(f.face.size(), 0.0);
   f.local.resize(f.raw.size());
@@ -218,10 +225,7 @@ void ImmersedSolid::gather(const Fixed& fixed, const Raw& moving, Faces& p, Scra
   p.fixed = &fixed;
   p.moving = &moving;
   auto& mf = p.moving_face;
-  mf.clear();
-  for (const Piece& q : moving)
-    if (slot[q.face] < 0) slot[q.face] = 0, mf.push_back(q.face);
-  std::sort(mf.begin(), mf.end());
+  touched_faces(moving, slot, mf);
   p.face.resize(mf.size() + fixed.face.size());
   p.face.erase(std::set_union(mf.begin(), mf.end(), fixed.face.begin(), fixed.face.end(),
                               p.face.begin()),

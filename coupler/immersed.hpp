@@ -131,6 +131,8 @@ class ImmersedSolid {
   struct Scratch {  // per face of a family: -1, or its slot while gather() or index_fixed() runs
     std::vector<std::int32_t> slot;
   };
+  static void touched_faces(const Raw& raw, std::vector<std::int32_t>& slot,
+                            std::vector<std::int32_t>& face);
   static void index_fixed(Fixed& f, Scratch& s);
   void gather(const Fixed& fixed, const Raw& moving, Faces& p, Scratch& s);
   void fill(const FaceBoxes& boxes, const Faces& p, const proto::SolidState& state, int component,

@@ -271,16 +271,15 @@ void Solver::finish_step(double dt, const CouplingIn& in, CouplingOut& out) {
 
   t0 = Clock::now();
   m_bnd.fill_ghosts(m_u, m_v);
-  const int nu = m_grid.nu(), nx = m_grid.nx();
   out.sample_u.resize(in.sample_u_index.size());
   out.sample_v.resize(in.sample_v_index.size());
   for (std::size_t q = 0; q < in.sample_u_index.size(); ++q) {
-    const auto idx = in.sample_u_index[q];
-    out.sample_u[q] = m_u(int(idx % nu), int(idx / nu));
+    const auto [i, j] = face_of(0, in.sample_u_index[q]);
+    out.sample_u[q] = m_u(i, j);
   }
   for (std::size_t q = 0; q < in.sample_v_index.size(); ++q) {
-    const auto idx = in.sample_v_index[q];
-    out.sample_v[q] = m_v(int(idx % nx), int(idx / nx));
+    const auto [i, j] = face_of(1, in.sample_v_index[q]);
+    out.sample_v[q] = m_v(i, j);
   }
   m_time.boundaries += since(t0);
 
@@ -330,7 +329,6 @@ void Solver::predictor(double dt, double t_half) {
 void Solver::add_fiber_force(double dt, const CouplingIn& in) {
   const double ri = 1.0 / m_cfg.density;
   const int nx = m_grid.nx(), ny = m_grid.ny();
-  const int nu = m_grid.nu();
   if (m_cfg.implicit) {
     const double scale = -1.0 / (0.5 * m_nu * dt);
     for (int comp = 0; comp < 2; ++comp) {
@@ -349,13 +347,11 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
     return;
   }
   for (std::size_t q = 0; q < in.fiber_u_index.size(); ++q) {
-    const auto idx = in.fiber_u_index[q];
-    const int i = int(idx % nu), j = int(idx / nu);
+    const auto [i, j] = face_of(0, in.fiber_u_index[q]);
     if (i >= m_i0 && i < nx) m_u(i, j) += dt * ri * in.fiber_u_force[q];
   }
   for (std::size_t q = 0; q < in.fiber_v_index.size(); ++q) {
-    const auto idx = in.fiber_v_index[q];
-    const int i = int(idx % nx), j = int(idx / nx);
+    const auto [i, j] = face_of(1, in.fiber_v_index[q]);
     if (j >= m_j0 && j < ny) m_v(i, j) += dt * ri * in.fiber_v_force[q];
   }
 }
@@ -505,7 +501,7 @@ void Solver::solve_implicit(double dt, const CouplingIn& in, CouplingOut& out) {
     const auto& us = comp == 0 ? in.solid_u_velocity : in.solid_v_velocity;
     auto& force = comp == 0 ? out.solid_u_force : out.solid_v_force;
     if (m_cfg.forcing_in_solve) force.resize(idx.size());
-    for (std::size_t q = 0; m_cfg.forcing_in_solve && q < idx.size(); ++q) {
+    for (std::size_t q = 0; q < (m_cfg.forcing_in_solve ? idx.size() : 0); ++q) {
       const auto [i, j] = face_of(comp, idx[q]);
       double f = 0;
       if (i >= ib && i < nx && j >= jb && j < ny) {
@@ -528,12 +524,11 @@ void Solver::solve_implicit(double dt, const CouplingIn& in, CouplingOut& out) {
 // i.e. u~ <- (1 - alpha) u~ + alpha u_s, on the solid's faces.
 void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out) {
   const double rho = m_cfg.density;
-  const int nx = m_grid.nx(), ny = m_grid.ny(), nu = m_grid.nu();
+  const int nx = m_grid.nx(), ny = m_grid.ny();
   out.solid_u_force.resize(in.solid_u_index.size());
   out.solid_v_force.resize(in.solid_v_index.size());
   for (std::size_t q = 0; q < in.solid_u_index.size(); ++q) {
-    const auto idx = in.solid_u_index[q];
-    const int i = int(idx % nu), j = int(idx / nu);
+    const auto [i, j] = face_of(0, in.solid_u_index[q]);
     double f = 0;
     if (i >= m_i0 && i < nx) {
       double& u = m_u(i, j);
@@ -543,8 +538,7 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
     out.solid_u_force[q] = f;
   }
   for (std::size_t q = 0; q < in.solid_v_index.size(); ++q) {
-    const auto idx = in.solid_v_index[q];
-    const int i = int(idx % nx), j = int(idx / nx);
+    const auto [i, j] = face_of(1, in.solid_v_index[q]);
     double f = 0;
     if (j >= m_j0 && j < ny) {
       double& v = m_v(i, j);
