@@ -23,7 +23,7 @@ usage: ./fsi COMMAND [ARGS]
                               mpirun job of the programs it needs; output in out/<scene name>/
   test [CTEST ARGS]           build, then run the whole test suite through CTest
   validate [CASE...]          run the validation cases in runs/ (all when none is named)
-  bench [WHAT]                run a benchmark (fluid, solid, fiber, coupled, protocol);
+  bench [WHAT]                run a benchmark (fluid, solid, fiber, coupler, coupled, protocol);
                               without WHAT, list them
   build                       install missing packages, configure and build (incremental)
   deps                        install missing Debian packages (as root) or list them

@@ -157,7 +157,7 @@ int main(int argc, char** argv) {
               "larger, and a thread is started per call)\n");
   std::printf("  one record per piece with its three weights (was: one per node in four arrays); "
               "barycentric map set up once per triangle; split, moments, box index inlined | -20 %% "
-              "| one thread 2.98-3.11 -> 2.38-2.58 ms (same session, same load)\n");
+              "| one thread 2.98-3.11 -> 2.38-2.58 ms (interleaved runs, same load)\n");
   std::printf("  fixed bodies' faces and areas kept from their one clipping, merged per face each "
               "step (was: their pieces gathered and summed every step) | the cylinder's -0.3 ms | "
               "CPU with the cylinder 2.25-2.56 -> 2.18-2.22 ms, bar alone unchanged (1.98-2.12 "

@@ -1,4 +1,4 @@
-// The coupler's step sequence (DESIGN.md §3; message order in common/PROTOCOL.md).
+// The coupler's step sequence (the paper's Sec. 3.3; message order in common/PROTOCOL.md).
 #include "coupler.hpp"
 
 #include <algorithm>
@@ -376,7 +376,7 @@ void Coupler::exchange(Role r, const In& in, Out& out, long n) {
   m_phases.stop(fsi::role_name(r));
 }
 
-// One step t^n -> t^(n+1), DESIGN.md §3, with coupled iterations when
+// One step t^n -> t^(n+1) (common/PROTOCOL.md), with coupled iterations when
 // coupler.iterations.max > 1 (README.md): steps 3-7 are repeated, the fluid redoing its forcing
 // and projection from the same predictor u~ and the solid its step from the state at t^n,
 // until the solid's velocities stop changing; then the step is committed and the fibers follow.
@@ -669,9 +669,9 @@ void Coupler::feedback_forces() {
 
 // The hydrodynamic force on each group: F = Σ_a F_a + d/dt (ρ_f ∫ v dA). The first term is the
 // reaction of f_s of this step (before any fiber root load is added); the second restores the
-// inertia of the fluid the forcing carries inside the body (DESIGN.md §4.2: ∫ f_s = ρ_f V a_s −
-// traction), from the bodies' momentum change over the previous step (the state at t^n is the
-// newest the coupler holds when the reaction is known).
+// inertia of the fluid the forcing carries inside the body (the fluid's momentum over the body:
+// ∫ f_s = ρ_f V a_s − traction), from the bodies' momentum change over the previous step (the
+// state at t^n is the newest the coupler holds when the reaction is known).
 void Coupler::write_force_probes(long n, const proto::SolidState& start,
                                  const std::vector<std::vector<double>>& reaction) {
   if (!m_probes) return;

@@ -1,6 +1,7 @@
 // The coupler: the clock of a coupled run and every Euler-Lagrange transfer between the fluid,
-// the solids and the fibers (DESIGN.md §3, §4.4). It knows the fluid only through the grid the
-// fluid describes at set-up, and the solids and fibers only through their meshes and markers.
+// the solids and the fibers (the paper's Sec. 3.2 and 3.3). It knows the fluid only through the
+// grid the fluid describes at set-up, and the solids and fibers only through their meshes and
+// markers.
 #pragma once
 
 #include <array>

@@ -1,4 +1,4 @@
-// The immersed solid method's transfers (paper Sec. 3.2.1, DESIGN.md §4.4): exact volume
+// The immersed solid method's transfers (paper Sec. 3.2.1): exact volume
 // fractions and mean solid velocities on the staggered control volumes a body touches, and the
 // exact nodal reaction of the fluid's forcing. Cost grows with the bodies' footprint, not the grid.
 #pragma once
@@ -70,8 +70,9 @@ class ImmersedSolid {
  public:
   ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshes& meshes);
 
-  // Step 2 of DESIGN.md §3, from the bodies' current state: for every face whose control volume
-  // V meets a body, α = min(1, Σ_bodies |V ∩ body| / |V|) and the mean solid velocity component
+  // Before message 2 of a step (common/PROTOCOL.md), from the bodies' current state: for every
+  // face whose control volume V meets a body, α = min(1, Σ_bodies |V ∩ body| / |V|) and the
+  // mean solid velocity component
   //   ū_s = Σ_T Σ_a u_a ∫_{V∩T} N_a dA / Σ_T |V ∩ T|,
   // exact because N_a is linear on each triangle T: ∫_P N_a dA = |P| N_a(centroid of P).
   // Rigid fixed bodies are clipped once and reused.

@@ -1,8 +1,9 @@
 // The fluid solver: 2D incompressible Navier-Stokes on a MAC grid, fractional step with AB2
 // convection (Euler on the first step), explicit AB2 or Crank-Nicolson diffusion, incremental
 // pressure projection with an exact direct Poisson solve. One step reads as the paper's
-// procedure (DESIGN.md section 3, step 4): predictor (with the fibers' force f_f), immersed-
-// solid forcing f_s, boundary conditions, Poisson right-hand side, solve, correct.
+// procedure (Sec. 3.3; between messages 2 and 3 of common/PROTOCOL.md): predictor (with the
+// fibers' force f_f), immersed-solid forcing f_s, boundary conditions, Poisson right-hand side,
+// solve, correct.
 #pragma once
 
 #include <array>

@@ -1,4 +1,4 @@
-// The solid side of the coupling (DESIGN.md §3, steps 1, 6, 7, 8; common/PROTOCOL.md): what the
+// The solid side of the coupling (common/PROTOCOL.md, messages 1, 4 and 5): what the
 // coupler needs from the solid solver and the one call that advances it. Layouts follow the
 // protocol: node vectors are interleaved (x0, y0, x1, y1, ...); forces are ON THE SOLID.
 //
