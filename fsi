@@ -187,10 +187,13 @@ r = {"steps": s["steps"], "us_per_step": s["coupler"]["us_per_step"],
 json.dump(r, open(sys.argv[2], "w"), indent=2)
 print(f"empty protocol step: {r['us_per_step']:.1f} us over {r['steps']} steps")
 print("notes: change | predicted | measured")
-print("  polite wait (yield, then sleep 5..200 us) instead of Open MPI's busy poll | programs that wait leave the cores | see below")
+print("  polite wait (yield, then sleep 5..200 us) instead of Open MPI's busy poll | programs that wait leave the cores | not measured then")
 print("  timer slack 1 us instead of Linux's 50 us | shorter wake-ups | 388 -> 174 us per empty step (one pair of runs)")
 print("  sleep cap 50 us instead of 200 us | faster hand-over | empty step 270-440 -> 133-218 us, but the default")
 print("      coupled scene 0.9-1.1 -> 1.6-1.7 s: the waiting programs steal the cores; kept at 200 us")
+print("  yields only, no sleeps (the sleeps and the timer slack removed) | no late wake-ups | empty step 41-90 ->")
+print("      37-47 us; default scene 57.6-58.5 -> 52.7-53.5 s, fibers-on-block 5.1 -> 3.3-3.5 s, ctest -j2 152 -> 141 s")
+print("      (interleaved runs); Open MPI's busy poll, which yields when oversubscribed: 50.9-53.6 s, 2.9-3.1 s")
 PY
 }
 
@@ -263,6 +266,9 @@ print("  the coupler alone with a 50 us sleep cap (the hub picks its answers up 
 print("  fixed bodies (the cylinder) handled per face, not per piece, after their one clipping | -0.3 ms"
       " footprint | footprint 1.40-2.41 -> 1.13-1.68 ms, coupler work + traffic / fluid step 0.22-0.33"
       " -> 0.19-0.26 (nine interleaved pairs); whole step within noise (12.1-15.8 against 12.1-15.1 ms)")
+print("  waiting by yields only, no sleeps (common/runtime.cpp) | -0.3 ms messages | within noise at this grid:"
+      " whole step 12.1-13.4 -> 11.3-12.9 ms, messages 0.59-0.92 -> 0.46-0.82 ms, ratio 0.19-0.26 -> 0.20-0.22"
+      " (three interleaved pairs): the messages here are not the sleeps' late wake-ups")
 print("  work ahead on a thread of its own at nice 19 (so a waking coupler gets a core at once) |"
       " -1 ms messages | worse: 18.2-22.7 ms (messages 2.1-3.3: the fluid's predictor starved beside"
       " the clipping, with one footprint thread too): not kept")

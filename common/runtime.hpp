@@ -62,7 +62,7 @@ struct CommonSettings {
 CommonSettings read_common(const SceneTable& root);
 
 // A point-to-point link to another program (an intercommunicator with one rank on each side).
-// send/recv wait politely (test, then sleep with back-off) so that a program waiting for a
+// send/recv wait by testing and yielding the core between tests, so that a program waiting for a
 // message leaves the core to the one that computes.
 class Link {
  public:
