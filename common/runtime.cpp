@@ -28,14 +28,14 @@ struct Announce {
   std::uint64_t options_hash;  // the output options: every program must be given the same
 };
 
-// A waiting program tests its request and yields the core between tests: it runs only when no
-// other program on its core is runnable, and picks its message up at the next test. Measured on
+// A waiting program tests its request and yields the core between tests: it hands the core to a
+// program ready to run there, and picks its message up at the next test. Measured on
 // 2 cores against yields then sleeps of 5 to 200 µs (interleaved runs): the default scene (three
 // programs, 16 000 steps) 52.7-53.5 s against 57.6-58.5 s, fibers-on-block (four programs)
 // 3.3-3.5 s against 5.1 s, the test suite (ctest -j2, two jobs at once) 141 s against 152 s, an
 // empty protocol step 37-47 µs against 41-90 µs. A sleep hands the core over no sooner than a
-// yield does, and wakes late. (Open MPI's own wait yields too, but only on a node it knows to be
-// oversubscribed.)
+// yield does, and wakes late. (Open MPI's own wait did as well, 50.9-53.6 s and 2.9-3.1 s, but it
+// yields only on a node it knows to be oversubscribed.)
 void wait_yielding(MPI_Request& req) {
   int done = 0;
   MPI_Test(&req, &done, MPI_STATUS_IGNORE);

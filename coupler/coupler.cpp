@@ -377,7 +377,7 @@ void Coupler::exchange(Role r, const In& in, Out& out, long n) {
 }
 
 // One step t^n -> t^(n+1) (common/PROTOCOL.md), with coupled iterations when
-// coupler.iterations.max > 1 (README.md): steps 3-7 are repeated, the fluid redoing its forcing
+// coupler.iterations.max > 1 (README.md): messages 1-5 are repeated, the fluid redoing its forcing
 // and projection from the same predictor u~ and the solid its step from the state at t^n,
 // until the solid's velocities stop changing; then the step is committed and the fibers follow.
 // With max = 1 this is the explicit staggered step, every operation in the same order.
