@@ -213,7 +213,7 @@ void ImmersedSolid::index_fixed(Fixed& f, Scratch& s) {
   for (std::size_t e = 0; e < f.raw.size(); ++e) {
     const Piece& q = f.raw[e];
     f.local[e] = slot[q.face];
-    f.area[f.local[e]] += q.w[0] + q.w[1] + q.w[2];
+    f.area[f.local[e]] += q.area();
   }
   for (const std::int32_t face : f.face) slot[face] = -1;
 }
@@ -241,7 +241,7 @@ void ImmersedSolid::gather(const Fixed& fixed, const Raw& moving, Faces& p, Scra
   p.slot_moving.resize(moving.size());
   for (std::size_t e = 0; e < moving.size(); ++e) {
     p.slot_moving[e] = slot[moving[e].face];
-    p.area[p.slot_moving[e]] += moving[e].w[0] + moving[e].w[1] + moving[e].w[2];
+    p.area[p.slot_moving[e]] += moving[e].area();
   }
   p.total_area = 0;
   for (std::size_t k = 0; k < nf; ++k) {
@@ -250,21 +250,25 @@ void ImmersedSolid::gather(const Fixed& fixed, const Raw& moving, Faces& p, Scra
   }
 }
 
+// A fixed body's pieces add nothing to ū_s while its nodes are at rest, which is what a fixed
+// body's state says; fill() sums them should it say otherwise.
+bool ImmersedSolid::fixed_at_rest(const proto::SolidState& state) const {
+  for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
+    if (m_meshes.bodies[b].kind == 1)
+      for (const double vb : state.v[b])
+        if (vb != 0.0) return false;
+  return true;
+}
+
 void ImmersedSolid::fill(const FaceBoxes& boxes, const Faces& p, const proto::SolidState& state,
-                         int component, proto::FaceSolid& out) const {
+                         int component, bool fixed_rest, proto::FaceSolid& out) const {
   const std::size_t nf = p.face.size();
   p.sum.assign(nf, 0.0);
   auto add = [&](const Piece& q, std::int32_t slot) {
     const double* v = state.v[q.body].data() + component;
     p.sum[slot] += q.w[0] * v[2 * q.node[0]] + q.w[1] * v[2 * q.node[1]] + q.w[2] * v[2 * q.node[2]];
   };
-  // A fixed body's pieces add nothing while its nodes are at rest, which is what a fixed body's
-  // state says; they are summed should it say otherwise.
-  bool fixed_at_rest = true;
-  for (std::size_t b = 0; b < m_meshes.bodies.size() && fixed_at_rest; ++b)
-    if (m_meshes.bodies[b].kind == 1)
-      for (const double vb : state.v[b]) fixed_at_rest = fixed_at_rest && vb == 0.0;
-  if (!fixed_at_rest)
+  if (!fixed_rest)
     for (std::size_t e = 0; e < p.fixed->raw.size(); ++e)
       add(p.fixed->raw[e], p.slot_fixed_face[p.fixed->local[e]]);
   for (std::size_t e = 0; e < p.moving->size(); ++e) add((*p.moving)[e], p.slot_moving[e]);
@@ -285,6 +289,7 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
   // The two families are independent (own boxes, pieces and scratch): the v-family runs on a
   // second thread while this one does the u-family. The solid waits meanwhile; the fluid runs its
   // predictor ahead of its input (one core's worth of work).
+  const bool fixed_rest = fixed_at_rest(state);
   auto family = [&](const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy, Fixed& fixed,
                     Raw& raw, Faces& p, Scratch& s, int c, proto::FaceSolid& out) {
     if (!m_fixed_done) {
@@ -296,7 +301,7 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
     for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
       if (bodies[b].kind != 1) clip_body(boxes, ix, iy, b, state.x[b], raw);
     gather(fixed, raw, p, s);
-    fill(boxes, p, state, c, out);
+    fill(boxes, p, state, c, fixed_rest, out);
   };
   if (m_threads) {
     std::thread second([&] { family(m_vb, m_vx, m_vy, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v); });
@@ -313,8 +318,9 @@ void ImmersedSolid::update_velocities(const proto::SolidState& state, proto::Fac
                                       proto::FaceSolid& v) const {
   if (state.v.size() != m_meshes.bodies.size())
     fsi::fail("solid state has {} bodies, the meshes {}", state.v.size(), m_meshes.bodies.size());
-  fill(m_ub, m_u, state, 0, u);
-  fill(m_vb, m_v, state, 1, v);
+  const bool fixed_rest = fixed_at_rest(state);
+  fill(m_ub, m_u, state, 0, fixed_rest, u);
+  fill(m_vb, m_v, state, 1, fixed_rest, v);
 }
 
 void ImmersedSolid::reaction(const std::vector<double>& fs_u, const std::vector<double>& fs_v,

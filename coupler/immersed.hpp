@@ -103,6 +103,7 @@ class ImmersedSolid {
     std::int32_t face, body;
     std::int32_t node[3];
     double w[3];
+    double area() const { return w[0] + w[1] + w[2]; }  // |P|: the weights sum to it
   };
   using Raw = std::vector<Piece>;
   // The rigid fixed bodies' pieces of one family, clipped once, and what never changes about
@@ -136,8 +137,9 @@ class ImmersedSolid {
                             std::vector<std::int32_t>& face);
   static void index_fixed(Fixed& f, Scratch& s);
   void gather(const Fixed& fixed, const Raw& moving, Faces& p, Scratch& s);
+  bool fixed_at_rest(const proto::SolidState& state) const;
   void fill(const FaceBoxes& boxes, const Faces& p, const proto::SolidState& state, int component,
-            proto::FaceSolid& out) const;
+            bool fixed_rest, proto::FaceSolid& out) const;
 
   const proto::BodyMeshes& m_meshes;
   FaceBoxes m_ub, m_vb;

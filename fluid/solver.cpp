@@ -500,8 +500,10 @@ void Solver::solve_implicit(double dt, const CouplingIn& in, CouplingOut& out) {
     const auto& alpha = comp == 0 ? in.solid_u_alpha : in.solid_v_alpha;
     const auto& us = comp == 0 ? in.solid_u_velocity : in.solid_v_velocity;
     auto& force = comp == 0 ? out.solid_u_force : out.solid_v_force;
-    if (m_cfg.forcing_in_solve) force.resize(idx.size());
-    for (std::size_t q = 0; q < (m_cfg.forcing_in_solve ? idx.size() : 0); ++q) {
+    // The forcing enters the solve here, or after it (immersed_forcing()).
+    const std::size_t nforced = m_cfg.forcing_in_solve ? idx.size() : 0;
+    if (m_cfg.forcing_in_solve) force.resize(nforced);
+    for (std::size_t q = 0; q < nforced; ++q) {
       const auto [i, j] = face_of(comp, idx[q]);
       double f = 0;
       if (i >= ib && i < nx && j >= jb && j < ny) {
