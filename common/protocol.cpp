@@ -82,7 +82,12 @@ void BodyMeshes::unpack(Reader& r) {
   r.get(n);
   if (n < 0 || n > (1 << 20)) fail("protocol error: body count {} out of range", n);
   bodies.resize(static_cast<std::size_t>(n));
-  for (auto& b : bodies) r.get(b.name), r.get(b.kind), r.get(b.x_ref), r.get(b.tri), r.get(b.edges);
+  for (auto& b : bodies) {
+    r.get(b.name), r.get(b.kind), r.get(b.x_ref), r.get(b.tri), r.get(b.edges);
+    const auto k = static_cast<std::int32_t>(b.kind);
+    if (k < 0 || k > static_cast<std::int32_t>(BodyKind::rigid_moving))
+      fail("protocol error: body '{}' has kind {}, not 0, 1 or 2", b.name, k);
+  }
   r.get(can_iterate);
 }
 

@@ -118,9 +118,14 @@ struct GridInfo {  // fluid -> coupler, once
   void unpack(Reader& r);
 };
 
+// How a body moves, as the coupler needs it: an elastic body's nodes move and carry velocities; a
+// rigid fixed body is clipped once; a rigid body with prescribed motion moves but takes no load.
+// On the wire an int32 (the values below).
+enum class BodyKind : std::int32_t { elastic = 0, rigid_fixed = 1, rigid_moving = 2 };
+
 struct BodyMesh {
   std::string name;
-  std::int32_t kind = 0;           // 0 elastic, 1 rigid fixed, 2 rigid with prescribed motion
+  BodyKind kind = BodyKind::elastic;
   std::vector<double> x_ref;       // reference node coordinates, 2 per node
   std::vector<std::int32_t> tri;   // 3 node indices per triangle, counter-clockwise
   std::vector<std::int32_t> edges; // surface edges, 2 node indices each, body on the left

@@ -45,7 +45,7 @@ fsi::proto::BodyMesh bar(double x0, double y0, double lx, double ly, int nx, int
 fsi::proto::BodyMesh disk(double cx, double cy, double r, int rings) {
   fsi::proto::BodyMesh m;
   m.name = "cylinder";
-  m.kind = 1;
+  m.kind = fsi::proto::BodyKind::rigid_fixed;
   m.x_ref = {cx, cy};
   int inner0 = 0;  // first node of ring k − 1
   for (int k = 1; k <= rings; ++k) {

@@ -97,7 +97,7 @@ namespace {
 std::array<double, 2> body_momentum(const proto::BodyMesh& b, const std::vector<double>& x,
                                     const std::vector<double>& v, double rho) {
   std::array<double, 2> p{0.0, 0.0};
-  if (b.kind == 1) return p;
+  if (b.kind == proto::BodyKind::rigid_fixed) return p;
   for (std::size_t e = 0; e + 2 < b.tri.size(); e += 3) {
     const int i = b.tri[e], j = b.tri[e + 1], k = b.tri[e + 2];
     const double area = 0.5 * std::abs((x[2 * j] - x[2 * i]) * (x[2 * k + 1] - x[2 * i + 1]) -
@@ -298,7 +298,7 @@ void Coupler::check_fibers_in_domain(long step) const {
 void Coupler::check_growth(long step) {
   for (std::size_t b = 0; b < m_meshes.bodies.size() && b < m_solid.x.size(); ++b) {
     const auto& body = m_meshes.bodies[b];
-    if (body.kind != 0) continue;
+    if (body.kind != proto::BodyKind::elastic) continue;
     const auto& x = m_solid.x[b];
     const auto& v = m_solid.v[b];
     auto& vo = m_velocity[b];
@@ -402,7 +402,7 @@ void Coupler::step(long n) {
     m_guess = m_start;
     if (m_v_before.size() == m_start.v.size())
       for (std::size_t b = 0; b < m_guess.v.size(); ++b)
-        if (m_meshes.bodies[b].kind == 0 && m_v_before[b].size() == m_guess.v[b].size())
+        if (m_meshes.bodies[b].kind == proto::BodyKind::elastic && m_v_before[b].size() == m_guess.v[b].size())
           for (std::size_t d = 0; d < m_guess.v[b].size(); ++d)
             m_guess.v[b][d] = 2 * m_start.v[b][d] - m_v_before[b][d];
     m_v_before = m_start.v;
@@ -447,13 +447,13 @@ void Coupler::step(long n) {
     m_reaction = m_solid_in.force;
     // Rigid bodies move by their law: their reaction is only measured, not sent.
     for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
-      if (m_meshes.bodies[b].kind != 0) m_solid_in.force[b].clear();
+      if (m_meshes.bodies[b].kind != proto::BodyKind::elastic) m_solid_in.force[b].clear();
     // With iterations the solid also gets the velocities this pass's forcing used (protocol
     // version 3): the reaction's linearisation dF/dv ~ -M_f/dt is about them.
     if (iterate) {
       m_solid_in.velocity = footprint->v;
       for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
-        if (m_meshes.bodies[b].kind != 0) m_solid_in.velocity[b].clear();
+        if (m_meshes.bodies[b].kind != proto::BodyKind::elastic) m_solid_in.velocity[b].clear();
     }
     add_root_loads(m_start);
     // 7: the solid step (or the same step again from its state at t^n).
@@ -489,7 +489,7 @@ void Coupler::step(long n) {
     scatter_velocities(m_x_next, m_guess);
     // Rigid bodies: their velocity at t^(n+1), as the solid just reported it.
     for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
-      if (m_meshes.bodies[b].kind != 0) m_guess.v[b] = m_solid.v[b];
+      if (m_meshes.bodies[b].kind != proto::BodyKind::elastic) m_guess.v[b] = m_solid.v[b];
     footprint = &m_guess;
     m_phases.stop("iterations");
   }
@@ -528,7 +528,7 @@ void Coupler::step(long n) {
     m_log->reaction(m_fluid_in, m_fluid_out, m_reaction);
     auto before = m_reaction;
     for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
-      if (m_meshes.bodies[b].kind != 0) before[b].clear();
+      if (m_meshes.bodies[b].kind != proto::BodyKind::elastic) before[b].clear();
     m_log->before_root_loads(before);
     root_poses(m_start, m_log_poses);
     m_log->root_loads(m_solid_in.force, m_fiber.root_load, m_log_poses);
@@ -553,13 +553,13 @@ void Coupler::step(long n) {
 void Coupler::gather_velocities(const proto::SolidState& s, std::vector<double>& x) const {
   x.clear();
   for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
-    if (m_meshes.bodies[b].kind == 0) x.insert(x.end(), s.v[b].begin(), s.v[b].end());
+    if (m_meshes.bodies[b].kind == proto::BodyKind::elastic) x.insert(x.end(), s.v[b].begin(), s.v[b].end());
 }
 
 void Coupler::scatter_velocities(const std::vector<double>& x, proto::SolidState& s) const {
   std::size_t i = 0;
   for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
-    if (m_meshes.bodies[b].kind == 0)
+    if (m_meshes.bodies[b].kind == proto::BodyKind::elastic)
       for (double& v : s.v[b]) v = x[i++];
 }
 

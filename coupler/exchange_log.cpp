@@ -69,7 +69,7 @@ ExchangeLog::ExchangeLog(const std::filesystem::path& out_dir, const proto::Grid
       const std::string g = "body_" + b.name;
       h.write(g + "/x_ref", b.x_ref, {b.x_ref.size() / 2, 2});
       h.write(g + "/triangles", std::span<const int>(b.tri), {b.tri.size() / 3, 3});
-      h.set_attribute(g, "kind", b.kind);
+      h.set_attribute(g, "kind", static_cast<int>(b.kind));
     }
     for (const auto& f : layout.fibers) {
       const std::string g = "fiber_" + f.name;

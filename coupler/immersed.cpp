@@ -254,7 +254,7 @@ void ImmersedSolid::gather(const Fixed& fixed, const Raw& moving, Faces& p, Scra
 // body's state says; fill() sums them should it say otherwise.
 bool ImmersedSolid::fixed_at_rest(const proto::SolidState& state) const {
   for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
-    if (m_meshes.bodies[b].kind == 1)
+    if (m_meshes.bodies[b].kind == proto::BodyKind::rigid_fixed)
       for (const double vb : state.v[b])
         if (vb != 0.0) return false;
   return true;
@@ -294,12 +294,12 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
                     Raw& raw, Faces& p, Scratch& s, int c, proto::FaceSolid& out) {
     if (!m_fixed_done) {
       for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
-        if (bodies[b].kind == 1) clip_body(boxes, ix, iy, b, state.x[b], fixed.raw);
+        if (bodies[b].kind == proto::BodyKind::rigid_fixed) clip_body(boxes, ix, iy, b, state.x[b], fixed.raw);
       index_fixed(fixed, s);
     }
     raw.clear();
     for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
-      if (bodies[b].kind != 1) clip_body(boxes, ix, iy, b, state.x[b], raw);
+      if (bodies[b].kind != proto::BodyKind::rigid_fixed) clip_body(boxes, ix, iy, b, state.x[b], raw);
     gather(fixed, raw, p, s);
     fill(boxes, p, state, c, fixed_rest, out);
   };

@@ -130,7 +130,9 @@ fsi::proto::BodyMeshes SolidProgram::meshes() const {
     const BodyGeometry g = hook.geometry(b);
     fsi::proto::BodyMesh m;
     m.name = g.name;
-    m.kind = g.kind == BodyKind::elastic ? 0 : (g.moving ? 2 : 1);
+    m.kind = g.kind == BodyKind::elastic ? fsi::proto::BodyKind::elastic
+             : g.moving                    ? fsi::proto::BodyKind::rigid_moving
+                                           : fsi::proto::BodyKind::rigid_fixed;
     m.x_ref = g.x_ref;
     for (const auto& t : g.triangles) m.tri.insert(m.tri.end(), t.begin(), t.end());
     for (const auto& e : g.surface) m.edges.insert(m.edges.end(), e.begin(), e.end());

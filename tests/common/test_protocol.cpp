@@ -26,15 +26,15 @@ TEST_CASE("every message survives a round trip") {
   CHECK(g2.density == 1000.0);
 
   BodyMeshes bm;
-  bm.bodies.push_back({"bar", 0, {0, 0, 1, 0, 0, 1}, {0, 1, 2}, {0, 1, 1, 2, 2, 0}});
-  bm.bodies.push_back({"cylinder", 1, {}, {}, {}});
+  bm.bodies.push_back({"bar", BodyKind::elastic, {0, 0, 1, 0, 0, 1}, {0, 1, 2}, {0, 1, 1, 2, 2, 0}});
+  bm.bodies.push_back({"cylinder", BodyKind::rigid_fixed, {}, {}, {}});
   bm.can_iterate = 1;
   const auto bm2 = round_trip(bm);
   CHECK(bm2.can_iterate == 1);
   REQUIRE(bm2.bodies.size() == 2);
   CHECK(bm2.bodies[0].name == "bar");
   CHECK(bm2.bodies[0].tri == bm.bodies[0].tri);
-  CHECK(bm2.bodies[1].kind == 1);
+  CHECK(bm2.bodies[1].kind == BodyKind::rigid_fixed);
 
   FiberLayout fl;
   fl.fibers.push_back({"f0", 63, 0.002, 1, "wall", 12, 0.25, 0.5, 0.125, 0.1});

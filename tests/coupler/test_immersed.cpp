@@ -264,7 +264,7 @@ TEST_CASE("the nodal reaction cancels the fluid forcing: action = reaction") {
   m.bodies.push_back(rectangle(0.3, 0.2, 8, 5, 0.3, {0.1, 0.5}));  // crosses x = 0
   double area = 0;
   m.bodies.push_back(disk(0.12, 4, {0.6, 0.45}, &area));
-  m.bodies[1].kind = 1;  // rigid fixed: clipped once, reused
+  m.bodies[1].kind = fsi::proto::BodyKind::rigid_fixed;  // rigid fixed: clipped once, reused
   ImmersedSolid is(g, m);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> r(-1, 1);
@@ -291,7 +291,7 @@ TEST_CASE("a fixed body's transfers are those of the same body clipped every ste
   clipped_each_step.bodies.push_back(disk(0.12, 4, {0.45, 0.45}, &area));
   clipped_each_step.bodies.push_back(rectangle(0.3, 0.2, 8, 5, 0.3, {0.62, 0.5}));  // overlaps it
   proto::BodyMeshes fixed = clipped_each_step;
-  fixed.bodies[0].kind = 1;
+  fixed.bodies[0].kind = fsi::proto::BodyKind::rigid_fixed;
   ImmersedSolid a(g, clipped_each_step), b(g, fixed);
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> r(-1, 1);

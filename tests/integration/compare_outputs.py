@@ -1,0 +1,149 @@
+#!/usr/bin/python3
+"""Compare the results of two builds bit for bit, on scenes that cover every program and mode.
+
+  compare_outputs.py --bin-a BUILD_A/bin --bin-b BUILD_B/bin --work DIR [--scenes NAME,...]
+  compare_outputs.py --dirs OUT_A OUT_B
+
+The first form runs each scene (shortened: t_end set below) with both builds' programs and
+compares the two output folders; the second compares two existing output folders. Compared:
+every CSV file byte for byte and every numeric dataset of every .h5 file value for value (NaN
+equal to NaN). Timings (summary.json, progress lines) are not results and are not compared.
+Exits 1 naming the first difference, when a run fails, or when a folder holds nothing to compare.
+"""
+import argparse
+import glob
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+# name: (scene, t_end or None for the scene's own). Together they cover the explicit step (default),
+# coupled iterations (equal-density), contact (contact-drop, contact-blocks), fibers rooted on a
+# body with Crank-Nicolson (fibers-on-block) and fibers in a channel (fiber-channel).
+SCENES = {
+    "default": ("runs/default/scene.toml", 0.5),
+    "iterated": ("runs/equal-density/fsi1.toml", 0.25),
+    "contact-drop": ("runs/contact-blocks/drop.toml", None),
+    "contact-blocks": ("runs/contact-blocks/blocks.toml", None),
+    "fibers-on-block": ("runs/fibers-on-block/scene.toml", 0.5),
+    "fiber-channel": ("runs/fiber-channel/scene.toml", 0.3),
+}
+
+
+def h5_datasets(path):
+    out = {}
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda name, obj: out.__setitem__(name, obj[()])
+                     if isinstance(obj, h5py.Dataset) and obj.dtype.kind in "fiu" else None)
+    return out
+
+
+def compare_dirs(first, second):
+    """The first difference between two output folders as a message, or None; and the count of
+    files and datasets compared."""
+    compared = 0
+    names = lambda d, ext: sorted(os.path.basename(p) for p in glob.glob(os.path.join(d, ext)))
+    for ext in ("*.csv", "*.h5"):
+        if names(first, ext) != names(second, ext):
+            return f"the folders hold other {ext} files: {names(first, ext)} against {names(second, ext)}", compared
+    for name in names(first, "*.csv"):
+        if open(os.path.join(first, name), "rb").read() != open(os.path.join(second, name), "rb").read():
+            return f"{name} differs", compared
+        compared += 1
+    for name in names(first, "*.h5"):
+        d1 = h5_datasets(os.path.join(first, name))
+        d2 = h5_datasets(os.path.join(second, name))
+        if sorted(d1) != sorted(d2):
+            return f"{name} holds other datasets", compared
+        for key, v in d1.items():
+            if v.shape != d2[key].shape or not np.array_equal(v, d2[key], equal_nan=v.dtype.kind == "f"):
+                return f"{name}:{key} differs", compared
+            compared += 1
+    if compared == 0:
+        return "nothing to compare", compared
+    return None, compared
+
+
+def roles_of(bin_dir, scene):
+    out = subprocess.run([os.path.join(bin_dir, "fsi-plan"), scene], capture_output=True, text=True)
+    if out.returncode != 0:
+        sys.exit(f"compare_outputs: fsi-plan failed on {scene}:\n{out.stderr}")
+    return re.search(r"^roles: (.*)$", out.stdout, re.M).group(1).split()
+
+
+def run(bin_dir, scene, out):
+    cmd = ["mpirun", "--oversubscribe"]
+    if os.geteuid() == 0:
+        cmd.append("--allow-run-as-root")
+    for k, p in enumerate(roles_of(bin_dir, scene)):
+        if k:
+            cmd.append(":")
+        cmd += ["-n", "1", os.path.join(bin_dir, p), scene, "--out-dir", out, "--overwrite"]
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
+    if r.returncode != 0:
+        sys.exit(f"compare_outputs: the run of {scene} with {bin_dir} failed (exit {r.returncode}):\n"
+                 f"{r.stderr[-3000:]}")
+
+
+def shortened(scene, t_end):
+    """The scene with t_end replaced, written beside it (its relative mesh paths still hold)."""
+    if t_end is None:
+        return scene, False
+    text = open(scene).read()
+    new, n = re.subn(r"(?m)^t_end\s*=.*$", f"t_end = {t_end!r}", text, count=1)
+    if n != 1:
+        sys.exit(f"compare_outputs: no t_end line in {scene}")
+    path = os.path.splitext(scene)[0] + "_compare.toml"
+    with open(path, "w") as f:
+        f.write(new)
+    return path, True
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--bin-a")
+    ap.add_argument("--bin-b")
+    ap.add_argument("--work", help="folder for the runs' outputs")
+    ap.add_argument("--scenes", default=",".join(SCENES), help="comma-separated: " + ",".join(SCENES))
+    ap.add_argument("--dirs", nargs=2, metavar=("OUT_A", "OUT_B"))
+    a = ap.parse_args()
+    if a.dirs:
+        diff, n = compare_dirs(*a.dirs)
+        if diff:
+            sys.exit(f"compare_outputs: {diff}")
+        print(f"compare_outputs: {n} files and datasets identical")
+        return
+    if not (a.bin_a and a.bin_b and a.work):
+        ap.error("--bin-a, --bin-b and --work are needed (or --dirs)")
+    failed = []
+    for name in a.scenes.split(","):
+        if name not in SCENES:
+            ap.error(f"unknown scene '{name}' (one of {', '.join(SCENES)})")
+        scene, t_end = SCENES[name]
+        scene, temporary = shortened(os.path.join(ROOT, scene), t_end)
+        try:
+            outs = []
+            for tag, bin_dir in (("a", a.bin_a), ("b", a.bin_b)):
+                out = os.path.join(os.path.abspath(a.work), name, tag)
+                shutil.rmtree(out, ignore_errors=True)
+                run(os.path.abspath(bin_dir), scene, out)
+                outs.append(out)
+        finally:
+            if temporary:
+                os.remove(scene)
+        diff, n = compare_dirs(*outs)
+        print(f"{name}: " + (f"DIFFERS: {diff}" if diff else f"{n} files and datasets identical"))
+        if diff:
+            failed.append(name)
+    if failed:
+        sys.exit(f"compare_outputs: {', '.join(failed)} differ")
+
+
+if __name__ == "__main__":
+    main()
