@@ -22,6 +22,10 @@ usage: ./fsi COMMAND [ARGS]
   run [SCENE] [--overwrite]   build, then run SCENE (default: runs/default/scene.toml) as one
                               mpirun job of the programs it needs; output in out/<scene name>/
   test [CTEST ARGS]           build, then run the whole test suite through CTest
+  test --debug [CTEST ARGS]   the same in a Debug build (build-debug/: internal assertions and
+                              bounds-checked field access on); unit and integration tests
+  test --sanitize [ARGS]      the same in an address + undefined-behaviour sanitizer build
+                              (build-sanitize/); unit and integration tests
   validate [CASE...]          run the validation cases in runs/ (all when none is named)
   bench [WHAT]                run a benchmark (fluid, solid, fiber, coupler, coupled, protocol);
                               without WHAT, list them
@@ -50,11 +54,21 @@ deps() {
   fi
 }
 
+# The kinds of build: release (build/, what runs use), debug and sanitize (checks for tests).
+build_flags() {
+  case "$1" in
+    release) echo "-DCMAKE_BUILD_TYPE=Release" ;;
+    debug) echo "-DCMAKE_BUILD_TYPE=Debug" ;;
+    sanitize) echo "-DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG=-O1 -DFSI_SANITIZE=ON" ;;
+  esac
+}
+
 build() {
+  local kind=${1:-release}
   deps
   if [ ! -f "$BUILD/CMakeCache.txt" ]; then
-    say "configuring in $BUILD"
-    cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release >/dev/null
+    say "configuring in $BUILD ($kind)"
+    cmake -S "$ROOT" -B "$BUILD" $(build_flags "$kind") >/dev/null
   fi
   say "building"
   local log=$BUILD/build.log
@@ -124,9 +138,22 @@ run() {
 }
 
 test_suite() {
-  build
+  local kind=release
+  case "${1:-}" in
+    --debug) kind=debug; shift ;;
+    --sanitize) kind=sanitize; shift ;;
+  esac
+  local select=()
+  if [ "$kind" != release ]; then
+    BUILD=${FSI_BUILD_DIR:-$ROOT/build-$kind}
+    BIN=$BUILD/bin
+    # The validation label holds the long runs; in these slower builds the suite checks the code
+    # paths (unit and integration tests) unless CTest arguments say otherwise.
+    [ $# -eq 0 ] && select=(-L "unit|integration")
+  fi
+  build "$kind"
   cd "$BUILD"
-  ctest --output-on-failure -j 2 --timeout 900 "$@"
+  ctest --output-on-failure -j 2 --timeout 900 "${select[@]}" "$@"
 }
 
 validate() {

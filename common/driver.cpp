@@ -10,11 +10,15 @@
 
 namespace fsi {
 
+// A step is an output step when it is the first of a new output interval; times within this
+// fraction of an interval below a multiple count as that multiple (round-off of n dt).
+constexpr double kIntervalTolerance = 1e-9;
+
 bool is_output_step(const CommonSettings& s, long n) {
   if (s.output_interval <= 0) return false;
   if (n == 0 || n == s.steps) return true;
-  const double k_now = std::floor(step_time(s, n) / s.output_interval + 1e-9);
-  const double k_before = std::floor(step_time(s, n - 1) / s.output_interval + 1e-9);
+  const double k_now = std::floor(step_time(s, n) / s.output_interval + kIntervalTolerance);
+  const double k_before = std::floor(step_time(s, n - 1) / s.output_interval + kIntervalTolerance);
   return k_now > k_before;
 }
 

@@ -5,7 +5,6 @@
 
 #include <fmt/format.h>
 
-#include <cassert>
 #include <stdexcept>
 #include <string>
 
@@ -27,7 +26,16 @@ template <class... Args>
   throw Error(fmt::format(f, std::forward<Args>(args)...));
 }
 
-// Internal invariant: checked in debug builds only.
-#define FSI_ASSERT(cond) assert(cond)
+[[noreturn]] inline void assertion_failed(const char* cond, const char* file, int line) {
+  throw Error(fmt::format("internal error: '{}' does not hold ({}:{}); please report it", cond, file, line));
+}
+
+// Internal invariant, checked in debug builds only (release builds define NDEBUG). A violation
+// goes through the funnel like any error, so the whole job ends with the place named.
+#ifdef NDEBUG
+#define FSI_ASSERT(cond) ((void)0)
+#else
+#define FSI_ASSERT(cond) ((cond) ? (void)0 : ::fsi::assertion_failed(#cond, __FILE__, __LINE__))
+#endif
 
 }  // namespace fsi

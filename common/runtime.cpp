@@ -28,14 +28,20 @@ struct Announce {
   std::uint64_t options_hash;  // the output options: every program must be given the same
 };
 
-// A waiting program tests its request and yields the core between tests: it hands the core to a
-// program ready to run there, and picks its message up at the next test. Measured on
-// 2 cores against yields then sleeps of 5 to 200 µs (interleaved runs): the default scene (three
-// programs, 16 000 steps) 52.7-53.5 s against 57.6-58.5 s, fibers-on-block (four programs)
-// 3.3-3.5 s against 5.1 s, the test suite (ctest -j2, two jobs at once) 141 s against 152 s, an
-// empty protocol step 37-47 µs against 41-90 µs. A sleep hands the core over no sooner than a
-// yield does, and wakes late. (Open MPI's own wait did as well, 50.9-53.6 s and 2.9-3.1 s, but it
-// yields only on a node it knows to be oversubscribed.)
+// The first word of every announcement ("FSI1"): a process that is not a program of this
+// project is refused by name.
+constexpr std::uint32_t kAnnounceMagic = 0x31495346u;
+// MPI tag of the intercommunicator between the coupler and a solver: this base plus the
+// solver's role number.
+constexpr int kLinkTagBase = 7100;
+// t_end / dt within this relative distance of an integer is that many steps (round-off of the
+// division); further away, the step count rounds up.
+constexpr double kStepCountTolerance = 1e-9;
+
+// A waiting program tests its request and yields the core between tests: with more programs
+// than cores it hands the core to a program ready to run there, and picks its message up at the
+// next test; a sleep would hand the core over no sooner and wake late (`./fsi bench protocol`,
+// common/PROTOCOL.md).
 void wait_yielding(MPI_Request& req) {
   int done = 0;
   MPI_Test(&req, &done, MPI_STATUS_IGNORE);
@@ -117,7 +123,7 @@ CommonSettings read_common(const SceneTable& root) {
   s.t_end = time.positive("t_end");
   const double n = s.t_end / s.dt;
   s.steps = std::lround(n);
-  if (std::abs(static_cast<double>(s.steps) - n) > 1e-9 * n) s.steps = static_cast<long>(std::ceil(n));
+  if (std::abs(static_cast<double>(s.steps) - n) > kStepCountTolerance * n) s.steps = static_cast<long>(std::ceil(n));
   if (s.steps < 1) s.steps = 1;
   time.finish();
 
@@ -188,12 +194,12 @@ std::vector<std::byte> Link::recv_bytes(proto::Tag expected) {
 // ---- Runtime ----------------------------------------------------------------------------------
 
 Link& Runtime::coupler_link() {
-  if (!m_links[static_cast<int>(Role::coupler)]) fail("{}: no coupler in this run", name());
+  if (!m_links[static_cast<int>(Role::coupler)]) fail("no coupler in this run");
   return *m_links[static_cast<int>(Role::coupler)];
 }
 
 Link& Runtime::link(Role solver) {
-  if (!m_links[static_cast<int>(solver)]) fail("{}: no link to {}", name(), role_name(solver));
+  if (!m_links[static_cast<int>(solver)]) fail("no link to the {}", role_name(solver));
   return *m_links[static_cast<int>(solver)];
 }
 
@@ -222,7 +228,7 @@ void check_job(const Runtime& rt, const std::vector<Announce>& all, const RoleSe
   std::array<int, kRoleCount> appnum;
   appnum.fill(-1);
   for (const auto& a : all) {
-    if (a.magic != 0x31495346u)  // "FSI1"
+    if (a.magic != kAnnounceMagic)
       fail("process {} of the job is not a program of this project", a.world_rank);
     if (a.role < 0 || a.role >= kRoleCount) fail("process {} announced an unknown role", a.world_rank);
     const char* who = kRoleNames[a.role];
@@ -286,7 +292,7 @@ int run_program(Role role, int argc, char** argv, const std::function<void(Runti
     root.finish();
 
     // Handshake: who is here, which protocol, which scene.
-    Announce me{0x31495346u,
+    Announce me{kAnnounceMagic,
                 rt.m_settings.bad_version_role == rt.name() ? proto::kVersion + 1000 : proto::kVersion,
                 static_cast<int>(role),
                 appnum,
@@ -349,19 +355,18 @@ int run_program(Role role, int argc, char** argv, const std::function<void(Runti
       MPI_Comm_size(job, &job_size);
       for (int k = 0; k < job_size; ++k)
         if (job_rank_of[ranks[k]] < 0) job_rank_of[ranks[k]] = k;
-      const int tag_base = 7100;
       if (role == Role::coupler) {
         for (Role s : {Role::fluid, Role::solid, Role::fiber}) {
           if (!rt.m_roles[s]) continue;
           MPI_Comm inter;
           MPI_Intercomm_create(local, 0, job, job_rank_of[static_cast<int>(s)],
-                               tag_base + static_cast<int>(s), &inter);
+                               kLinkTagBase + static_cast<int>(s), &inter);
           rt.m_links[static_cast<int>(s)] = std::make_unique<Link>(inter, s);
         }
       } else {
         MPI_Comm inter;
         MPI_Intercomm_create(local, 0, job, job_rank_of[static_cast<int>(Role::coupler)],
-                             tag_base + static_cast<int>(role), &inter);
+                             kLinkTagBase + static_cast<int>(role), &inter);
         rt.m_links[static_cast<int>(Role::coupler)] = std::make_unique<Link>(inter, Role::coupler);
       }
     }

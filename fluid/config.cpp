@@ -45,11 +45,6 @@ double explicit_diffusion_limit(const Config& c) {
   return 1.0 / (4.0 * nu * (1.0 / (hx * hx) + 1.0 / (hy * hy)));
 }
 
-double in_solve_density_bound(const Config& c, double dt) {
-  const double hx = min_width(c.x), hy = min_width(c.y);
-  return 2.0 * c.viscosity * dt * (1.0 / (hx * hx) + 1.0 / (hy * hy));
-}
-
 void validate(const Config& c, double dt) {
   if (!(c.density > 0)) bad(c, fmt::format("fluid.density must be > 0, got {}", c.density));
   if (!(c.viscosity > 0)) bad(c, fmt::format("fluid.viscosity must be > 0, got {}", c.viscosity));
@@ -184,11 +179,6 @@ Config read_config(const fsi::SceneTable& f, double dt) {
   c.density = f.positive("density");
   c.viscosity = f.positive("viscosity");
   c.implicit = f.choice("diffusion", {"explicit", "implicit"}, "explicit") == "implicit";
-  c.forcing_in_solve =
-      f.choice("immersed_forcing", {"after_solve", "in_solve"}, "after_solve") == "in_solve";
-  if (c.forcing_in_solve && !c.implicit)
-    f.fail("immersed_forcing", "\"in_solve\" needs diffusion = \"implicit\" (the explicit "
-                               "predictor has no solve)");
 
   const fsi::SceneTable g = f.table("grid");
   const std::vector<double> cells = g.numbers("cells");

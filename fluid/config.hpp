@@ -58,9 +58,6 @@ struct Config {
   AxisSpec x, y;
   std::array<SideBc, 4> bc;  // left, right, bottom, top
   bool implicit = false;     // Crank-Nicolson diffusion (else explicit AB2)
-  // Crank-Nicolson: the immersed forcing inside the solve, from the explicit estimate (else on
-  // the solve's result; Solver::predictor_implicit).
-  bool forcing_in_solve = false;
   // Body force per unit volume f(t) = body + oscillating sin(2 pi t / period + phase) (Eq. 29
   // with body = 0), plus rho g.
   std::array<double, 2> body{0, 0}, oscillating{0, 0}, gravity{0, 0};
@@ -85,13 +82,5 @@ void validate(const Config& c, double dt);
 
 // Largest dt of explicit AB2 diffusion: 1 / (4 nu (1/dx_min^2 + 1/dy_min^2)).
 double explicit_diffusion_limit(const Config& c);
-
-// The density an elastic body needs, by the two-mode model above Solver::predictor_implicit,
-// for the explicit staggered coupling to hold it with the forcing inside the Crank-Nicolson
-// solve (immersed_forcing = "in_solve"): the model asks nu dt kappa / h^2 < 2 rho_s / rho_f for
-// every grid mode, and kappa / h^2 <= 4 (1/dx_min^2 + 1/dy_min^2), so
-// rho_s > 2 rho_f nu dt (1/dx_min^2 + 1/dy_min^2) (4 lambda rho_f on a uniform square grid).
-// Necessary in the model, not sufficient in practice (fluid/README.md).
-double in_solve_density_bound(const Config& c, double dt);
 
 }  // namespace fluid

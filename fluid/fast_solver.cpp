@@ -4,7 +4,8 @@
 
 #include <cmath>
 #include <numbers>
-#include <stdexcept>
+
+#include "error.hpp"
 
 namespace fluid {
 namespace {
@@ -17,12 +18,16 @@ struct Kinds {
 Kinds kinds_for(int n, Closure lo, Closure hi) {
   using C = Closure;
   if (lo == C::periodic && hi == C::periodic) return {FFTW_R2HC, FFTW_HC2R, double(n)};
-  if (lo == C::dirichlet_node && hi == C::dirichlet_node) return {FFTW_RODFT00, FFTW_RODFT00, 2.0 * (n + 1)};
+  if (lo == C::dirichlet_node && hi == C::dirichlet_node)
+    return {FFTW_RODFT00, FFTW_RODFT00, 2.0 * (n + 1)};
   if (lo == C::neumann_half && hi == C::neumann_half) return {FFTW_REDFT10, FFTW_REDFT01, 2.0 * n};
-  if (lo == C::dirichlet_half && hi == C::dirichlet_half) return {FFTW_RODFT10, FFTW_RODFT01, 2.0 * n};
-  if (lo == C::dirichlet_half && hi == C::neumann_half) return {FFTW_RODFT11, FFTW_RODFT11, 2.0 * n};
-  if (lo == C::neumann_half && hi == C::dirichlet_half) return {FFTW_REDFT11, FFTW_REDFT11, 2.0 * n};
-  throw std::invalid_argument("fluid::FastSolver: no real transform for this pair of closures");
+  if (lo == C::dirichlet_half && hi == C::dirichlet_half)
+    return {FFTW_RODFT10, FFTW_RODFT01, 2.0 * n};
+  if (lo == C::dirichlet_half && hi == C::neumann_half)
+    return {FFTW_RODFT11, FFTW_RODFT11, 2.0 * n};
+  if (lo == C::neumann_half && hi == C::dirichlet_half)
+    return {FFTW_REDFT11, FFTW_REDFT11, 2.0 * n};
+  fsi::fail("fluid::FastSolver: no real transform for this pair of closures");
 }
 
 }  // namespace
@@ -104,7 +109,7 @@ FastSolver::FastSolver(const Operator1D& t, const Operator1D& s, double sigma)
       }
     }
   }
-  if (!m_fwd || !m_bwd) throw std::runtime_error("fluid::FastSolver: FFTW could not plan");
+  if (!m_fwd || !m_bwd) fsi::fail("fluid::FastSolver: FFTW could not plan the transforms");
 }
 
 FastSolver::~FastSolver() {
@@ -113,8 +118,12 @@ FastSolver::~FastSolver() {
   fftw_free(m_buf);
 }
 
-void FastSolver::forward() { fftw_execute(m_fwd); }
-void FastSolver::backward() { fftw_execute(m_bwd); }
+void FastSolver::forward() {
+  fftw_execute(m_fwd);
+}
+void FastSolver::backward() {
+  fftw_execute(m_bwd);
+}
 
 // Per wavenumber k: a_j y_{j-1} + (b_j + lambda_k - sigma) y_j + c_j y_{j+1} = rhat_j / norm,
 // forward elimination then back substitution, vectorised across k (k is contiguous).

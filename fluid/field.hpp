@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <vector>
 
+#include "error.hpp"
+
 namespace fluid {
 
 struct Field {
@@ -14,10 +16,17 @@ struct Field {
   std::vector<double> a;
 
   Field() = default;
-  Field(int ni_, int nj_) : ni(ni_), nj(nj_), sx(ni_ + 2), a(std::size_t(ni_ + 2) * (nj_ + 2), 0.0) {}
-  // (i, j) with i in [-1, ni], j in [-1, nj]
-  double& operator()(int i, int j) { return a[std::size_t(i + 1) + std::size_t(sx) * (j + 1)]; }
-  double operator()(int i, int j) const { return a[std::size_t(i + 1) + std::size_t(sx) * (j + 1)]; }
+  Field(int ni_, int nj_)
+      : ni(ni_), nj(nj_), sx(ni_ + 2), a(std::size_t(ni_ + 2) * (nj_ + 2), 0.0) {}
+  // (i, j) with i in [-1, ni], j in [-1, nj] (checked in debug builds)
+  double& operator()(int i, int j) {
+    FSI_ASSERT(i >= -1 && i <= ni && j >= -1 && j <= nj);
+    return a[std::size_t(i + 1) + std::size_t(sx) * (j + 1)];
+  }
+  double operator()(int i, int j) const {
+    FSI_ASSERT(i >= -1 && i <= ni && j >= -1 && j <= nj);
+    return a[std::size_t(i + 1) + std::size_t(sx) * (j + 1)];
+  }
   // Pointer to element (0, j); valid offsets -1 .. ni.
   double* row(int j) { return a.data() + 1 + std::size_t(sx) * (j + 1); }
   const double* row(int j) const { return a.data() + 1 + std::size_t(sx) * (j + 1); }

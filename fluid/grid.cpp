@@ -2,12 +2,15 @@
 #include "grid.hpp"
 
 #include <cmath>
-#include <stdexcept>
+
+#include "error.hpp"
 
 namespace fluid {
 
 Axis::Axis(const AxisSpec& s) : m_n(s.cells + s.sponge_cells), m_periodic(s.periodic) {
-  if (s.cells < 1 || !(s.length > 0)) throw std::invalid_argument("fluid::Axis: empty axis");
+  if (s.cells < 1 || !(s.length > 0))
+    fsi::fail("fluid::Axis: an axis needs cells >= 1 and a length > 0, got {} cells over {}",
+              s.cells, s.length);
   const int n = m_n;
   std::vector<double> f(n + 1);
   for (int i = 0; i <= s.cells; ++i) {

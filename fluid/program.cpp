@@ -32,11 +32,13 @@ FluidProgram::FluidProgram(fsi::Runtime& rt)
     m_h5.write(fmt::format("grid/tau_{}_position", kSideNames[s]), pos);
   }
   m_xdmf.emplace(rt.out_dir() / "fluid.xdmf", rt.out_dir() / "fluid.h5",
-                 fsi::XdmfRectilinear{"/grid/x_face", xf.size(), "/grid/y_face", yf.size()}, "fluid");
+                 fsi::XdmfRectilinear{"/grid/x_face", xf.size(), "/grid/y_face", yf.size()},
+                 "fluid");
   if (!m_cfg.probes.empty()) {
     std::vector<std::string> names;
     for (const Probe& p : m_cfg.probes) names.push_back(p.name);
-    m_probes.emplace(rt.out_dir() / "fluid_probes.csv", fsi::probe_columns(names, {"ux", "uy", "p"}));
+    m_probes.emplace(rt.out_dir() / "fluid_probes.csv",
+                     fsi::probe_columns(names, {"ux", "uy", "p"}));
     m_row.resize(3 * names.size());
   }
 }
@@ -60,13 +62,10 @@ fsi::proto::GridInfo FluidProgram::grid_info() const {
 // step_begin.
 void FluidProgram::prepare_next(const fsi::proto::StepBegin& done) {
   m_solver->begin_step(done.dt);
-  m_begun = true;
 }
 
 void FluidProgram::begin(const fsi::proto::StepBegin& s) {
-  if (m_begun) return;
-  m_solver->begin_step(s.dt);
-  m_begun = true;
+  if (!m_solver->is_begun()) m_solver->begin_step(s.dt);
 }
 
 void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::FluidInput& in,
@@ -85,11 +84,9 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
   c.sample_u_index = in.sample_u;
   c.sample_v_index = in.sample_v;
   if (s.iteration == 0) {
-    warn_in_solve(s, in);
     m_solver->set_keep_for_redo(s.may_repeat != 0);
-    if (m_begun) m_solver->end_step(s.dt, c, m_out);
-    else m_solver->step(s.dt, c, m_out);
-    m_begun = false;
+    begin(s);
+    m_solver->end_step(s.dt, c, m_out);
   } else {
     m_solver->redo_step(s.dt, c, m_out);
   }
@@ -103,24 +100,6 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
   out.kinetic_energy = m_energy;
 }
 
-void FluidProgram::warn_in_solve(const fsi::proto::StepBegin& s, const fsi::proto::FluidInput& in) {
-  if (m_warned_in_solve || !m_cfg.implicit || !m_cfg.forcing_in_solve || s.may_repeat != 0) return;
-  if (in.solid_u.index.empty() && in.solid_v.index.empty()) return;
-  m_warned_in_solve = true;
-  // The explicit coupling needs rho_s > 2 rho_f in any case (coupler/README.md); say nothing when
-  // every such body is well above the forcing's bound (a margin of 1.25: the wavy channel failed
-  // with a body 1.06 times as dense as the bound, runs/wavy-channel).
-  const double bound = in_solve_density_bound(m_cfg, s.dt);
-  if (1.25 * bound <= 2.0 * m_cfg.density) return;
-  fmt::print(stderr,
-             "[fluid] WARNING: fluid.immersed_forcing = \"in_solve\" with the explicit coupling "
-             "needs an elastic body's density well above {:.3g} (a model's bound, 2 rho_f nu dt "
-             "(1/dx^2 + 1/dy^2) at dt = {:g}, and a body 1.06 times as dense failed): a lighter "
-             "body can grow a mode that does not stop the run. Add [coupler.iterations] or lower "
-             "time.dt (fluid/README.md)\n",
-             bound, s.dt);
-}
-
 void FluidProgram::check_health(long step, double t, double dt) {
   const Extremum c = cfl(*m_solver, dt);
   m_cfl = c.value;
@@ -128,9 +107,10 @@ void FluidProgram::check_health(long step, double t, double dt) {
   if (!std::isfinite(c.value)) {
     what = "the velocity is not finite (NaN or Inf)";
   } else if (c.value > m_cfg.cfl_max) {
-    what = fmt::format("CFL number {:.4g} above fluid.health.cfl_max = {:g} in cell ({}, {}) at "
-                       "(x, y) = ({:.6g}, {:.6g}); lower time.dt",
-                       c.value, m_cfg.cfl_max, c.i, c.j, c.x, c.y);
+    what = fmt::format(
+        "CFL number {:.4g} above fluid.health.cfl_max = {:g} in cell ({}, {}) at "
+        "(x, y) = ({:.6g}, {:.6g}); lower time.dt",
+        c.value, m_cfg.cfl_max, c.i, c.j, c.x, c.y);
   } else if (step % m_cfg.health_every == 0) {
     const Extremum d = max_divergence(*m_solver);
     m_div = d.value;
@@ -138,15 +118,17 @@ void FluidProgram::check_health(long step, double t, double dt) {
     if (m_div_first < 0) m_div_first = d.value;
     // Round-off grows slowly with the field; a jump by orders of magnitude is a failure.
     if (d.value * dt > m_cfg.divergence_max) {
-      what = fmt::format("divergence |div u| dt = {:.3g} above fluid.health.divergence_max = {:g} "
-                         "in cell ({}, {}) at (x, y) = ({:.6g}, {:.6g})",
-                         d.value * dt, m_cfg.divergence_max, d.i, d.j, d.x, d.y);
+      what = fmt::format(
+          "divergence |div u| dt = {:.3g} above fluid.health.divergence_max = {:g} "
+          "in cell ({}, {}) at (x, y) = ({:.6g}, {:.6g})",
+          d.value * dt, m_cfg.divergence_max, d.i, d.j, d.x, d.y);
     }
   }
   if (what.empty()) return;
   write_fields(step, t);
-  throw fsi::Error(fmt::format("fluid unhealthy at step {}, t = {:.6g}: {} (last state written to {})",
-                               step, t, what, (m_rt.out_dir() / "fluid.h5").string()));
+  throw fsi::Error(
+      fmt::format("fluid unhealthy at step {}, t = {:.6g}: {} (last state written to {})", step, t,
+                  what, (m_rt.out_dir() / "fluid.h5").string()));
 }
 
 void FluidProgram::write_fields(long step, double t) {
@@ -208,8 +190,10 @@ nlohmann::json FluidProgram::report() const {
   j["grid"] = {m_solver->grid().nx(), m_solver->grid().ny()};
   j["steps"] = tm.steps;
   if (tm.repeats > 0) j["repeated_steps"] = tm.repeats;
-  j["phases"] = {{"predictor", tm.predictor}, {"boundaries", tm.boundaries},
-                 {"poisson", tm.poisson}, {"projection", tm.projection}};
+  j["phases"] = {{"predictor", tm.predictor},
+                 {"boundaries", tm.boundaries},
+                 {"poisson", tm.poisson},
+                 {"projection", tm.projection}};
   j["ns_per_cell_step"] = 1e9 * total / (cells * steps);
   j["max_divergence"] = max_divergence(*m_solver).value;
   j["kinetic_energy"] = kinetic_energy(*m_solver);

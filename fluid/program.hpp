@@ -30,9 +30,6 @@ class FluidProgram : public fsi::FluidPort {
   void write_fields(long step, double t);
   // Health: NaN/Inf, CFL above its limit, divergence growth. Writes the state, then throws.
   void check_health(long step, double t, double dt);
-  // With the forcing inside the Crank-Nicolson solve and the explicit coupling (no coupled
-  // iterations), say once which elastic bodies the coupling may not hold (in_solve_density_bound).
-  void warn_in_solve(const fsi::proto::StepBegin& s, const fsi::proto::FluidInput& in);
 
   fsi::Runtime& m_rt;
   Config m_cfg;
@@ -42,11 +39,9 @@ class FluidProgram : public fsi::FluidPort {
   std::optional<fsi::ProbeCsv> m_probes;
   std::vector<double> m_row, m_w1, m_w2;
   CouplingOut m_out;
-  bool m_begun = false;  // begin() took the step's first part
   double m_cfl = 0, m_div = 0, m_div_first = -1;
   double m_energy = 0;  // kinetic energy, refreshed with the divergence every health.every steps
   long m_written_step = -1;
-  bool m_warned_in_solve = false;  // the in-solve forcing's density bound, said once
 };
 
 }  // namespace fluid

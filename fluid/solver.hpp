@@ -43,9 +43,7 @@ struct CouplingIn {
 };
 // Output of one step:
 //   solid_*_force: f_s = rho_f alpha (u_s - u~) / dt on the solid's faces, in the input order,
-//                  force per unit volume ON THE FLUID (the solid receives its reaction);
-//                  with the forcing in the Crank-Nicolson solve, u^, the explicit estimate,
-//                  for u~ (predictor_implicit).
+//                  force per unit volume ON THE FLUID (the solid receives its reaction).
 //   sample_*:      u^(n+1) on the requested faces, in the input order.
 struct CouplingOut {
   std::vector<double> solid_u_force, solid_v_force;
@@ -73,22 +71,22 @@ class Solver {
   // Axis whose direction the fast solver transforms (0 = x, 1 = y).
   int transform_axis() const { return m_t_axis; }
 
+  // One step, t^n -> t^(n+1): predictor, immersed forcing, projection, samples (solver.cpp).
   void step(double dt);
   void step(double dt, const CouplingIn& in, CouplingOut& out);
   // The same step in two parts, so that the first runs before the coupling input exists:
   // begin_step() does everything up to the predictor u~ without the fibers' force (Crank-Nicolson:
-  // up to its right-hand side); end_step() adds that force, then the Crank-Nicolson solve, the
-  // immersed forcing, projection and samples. Bit-identical to step(dt, in, out).
+  // up to its right-hand side); end_step() adds that force (Crank-Nicolson: then solves), then
+  // the immersed forcing, projection and samples. step() is begin_step() then end_step().
   void begin_step(double dt);
   void end_step(double dt, const CouplingIn& in, CouplingOut& out);
+  bool is_begun() const { return m_phase == Phase::begun; }
   // Coupled iterations: the step just taken again from its predictor u~ and p^n (kept by
-  // step() while set_keep_for_redo(true), the default; Crank-Nicolson: from its kept right-hand
-  // side and explicit estimate), with new solid input: immersed forcing (Crank-Nicolson: and
-  // its solve again), projection, samples. The fibers' force and the predictor are not recomputed (in.fiber_* is
-  // ignored). dt must be that of the step.
+  // end_step() while set_keep_for_redo(true), the default), with new solid input: immersed
+  // forcing, projection, samples. The fibers' force and the predictor are not recomputed
+  // (in.fiber_* is ignored). dt must be that of the step.
   void redo_step(double dt, const CouplingIn& in, CouplingOut& out);
-  // Whether step() keeps u~, v~ (Crank-Nicolson: the fields before its solve) and p^n for a redo
-  // (three copies of the grid each step).
+  // Whether end_step() keeps u~, v~ and p^n for a redo (three copies of the grid each step).
   void set_keep_for_redo(bool keep) { m_keep_for_redo = keep; }
 
   // Fields. u: (nx+1) x ny, v: nx x (ny+1), p: nx x ny, with ghosts (Field). After set-up of
@@ -114,17 +112,22 @@ class Solver {
   FastSolver& poisson() { return *m_poisson; }
 
  private:
-  void build_implicit(double dt);
-  void explicit_terms();  // H(u^n) into m_hu, m_hv (and L u^n into m_lu, m_lv when implicit)
-  void predict(double dt, const CouplingIn* fibers);
-  void end_predicted(double dt, const CouplingIn& in, CouplingOut& out);
-  void predictor(double dt, double t_half);
-  void add_fiber_force(double dt, const CouplingIn& fibers);
-  void predictor_implicit(double dt, double t_half);
-  void solve_implicit(double dt, const CouplingIn& in, CouplingOut& out);
-  void immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out);
-  void project(double dt);
-  void finish_step(double dt, const CouplingIn& in, CouplingOut& out);
+  // Where the step stands: between steps, its first part done (begin_step), or done with its
+  // predictor kept (a redo may follow).
+  enum class Phase { between_steps, begun, redoable };
+
+  void build_implicit(double dt);                                            // solver.cpp
+  void explicit_terms();                                                     // predictor.cpp
+  void predictor(double dt, double t_half);                                  // predictor.cpp
+  void predictor_implicit(double dt, double t_half);                         // predictor.cpp
+  void add_fiber_force(double dt, const CouplingIn& fibers);                 // predictor.cpp
+  void solve_implicit();                                                     // predictor.cpp
+  void immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out);  // forcing.cpp
+  void project(double dt);                                                   // projection.cpp
+  void keep_predictor();                                                     // solver.cpp
+  void restore_predictor();                                                  // solver.cpp
+  void correct(double dt, const CouplingIn& in, CouplingOut& out);           // solver.cpp
+  void sample(const CouplingIn& in, CouplingOut& out) const;                 // solver.cpp
   // (i, j) of the face with the coupling index idx, of u (comp 0) or v (comp 1).
   std::array<int, 2> face_of(int comp, std::int32_t idx) const {
     const int w = comp == 0 ? m_grid.nu() : m_grid.nx();
@@ -149,12 +152,12 @@ class Solver {
   Field m_u_pred, m_v_pred, m_p_start;
   double m_t_start = 0, m_dt_prev_start = 0;
   bool m_keep_for_redo = true;
-  bool m_can_redo = false;  // the last step() kept its predictor
-  double m_begun_dt = 0;      // dt of the step begin_step() began (0: none)
+  Phase m_phase = Phase::between_steps;
+  double m_begun_dt = 0;  // dt of the step begin_step() began
   std::unique_ptr<FastSolver> m_poisson, m_helm_u, m_helm_v;
-  // Crank-Nicolson: the step's right-hand side B (scaled) and explicit estimate u^, per component,
-  // in the Helmholtz solver's layout (predictor_implicit).
-  std::array<std::vector<double>, 2> m_rhs, m_hat;
+  // Crank-Nicolson: the step's right-hand side B (scaled), per component, in the Helmholtz
+  // solver's layout (predictor_implicit), until its solve.
+  std::array<std::vector<double>, 2> m_rhs;
   Timings m_time;
 };
 

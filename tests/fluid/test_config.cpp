@@ -99,27 +99,3 @@ TEST_CASE("unknown keys are errors", "[fluid][config]") {
                     Contains("viscocity"));
 }
 
-TEST_CASE("immersed_forcing: its two values, and in_solve only with Crank-Nicolson", "[fluid][config]") {
-  const std::string cn = replace(kGood, "viscosity = 0.01", "viscosity = 0.01\ndiffusion = \"implicit\"");
-  CHECK_FALSE(read(cn, 0.01).forcing_in_solve);
-  CHECK(read(replace(cn, "diffusion = \"implicit\"", "diffusion = \"implicit\"\nimmersed_forcing = \"in_solve\""), 0.01)
-            .forcing_in_solve);
-  CHECK_THROWS_WITH(read(replace(cn, "diffusion = \"implicit\"", "diffusion = \"implicit\"\nimmersed_forcing = \"inside\""), 0.01),
-                    Contains("immersed_forcing") && Contains("inside"));
-  CHECK_THROWS_WITH(read(replace(kGood, "viscosity = 0.01", "viscosity = 0.01\nimmersed_forcing = \"in_solve\""), 0.01),
-                    Contains("fluid.immersed_forcing") && Contains("needs diffusion = \"implicit\""));
-}
-
-TEST_CASE("the in-solve forcing's density bound is 4 lambda rho_f on a square grid", "[fluid][config]") {
-  // kGood: 32 x 16 cells on 2 x 1, h = 1/16 both ways; mu = 0.01, rho_f = 1, so nu = 0.01.
-  const double dt = 0.01;
-  const double lambda = 0.01 * dt * 16.0 * 16.0;
-  const fluid::Config c = read(kGood, dt);
-  CHECK(fluid::in_solve_density_bound(c, dt) == Approx(4.0 * lambda * 1.0).epsilon(1e-14));
-  // rho_f nu = mu: a denser fluid of the same mu has the same bound.
-  const fluid::Config d = read(replace(kGood, "density = 1.0", "density = 5.0"), dt);
-  CHECK(fluid::in_solve_density_bound(d, dt) == Approx(4.0 * lambda).epsilon(1e-14));
-  // Uneven cells: the smaller spacing dominates, 2 mu dt (1/dx^2 + 1/dy^2).
-  const fluid::Config e = read(replace(kGood, "cells = [32, 16]", "cells = [64, 16]"), dt);
-  CHECK(fluid::in_solve_density_bound(e, dt) == Approx(2.0 * 0.01 * dt * (32.0 * 32.0 + 16.0 * 16.0)).epsilon(1e-14));
-}

@@ -23,16 +23,19 @@ import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-# name: (scene, t_end or None for the scene's own). Together they cover the explicit step (default),
-# coupled iterations (equal-density), contact (contact-drop, contact-blocks), fibers rooted on a
-# body with Crank-Nicolson (fibers-on-block) and fibers in a channel (fiber-channel).
+# name: (scene, t_end or None for the scene's own, text appended). Together they cover the explicit step (default),
+# coupled iterations with explicit diffusion (iterated) and with Crank-Nicolson (iterated-cn),
+# contact (contact-drop, contact-blocks), fibers rooted on a body with Crank-Nicolson
+# (fibers-on-block) and fibers in a channel (fiber-channel).
+ITERATIONS = "\n[coupler.iterations]\nmax = 30\ntolerance = 1e-6\nrelaxation = 0.5\nreuse = 20\n"
 SCENES = {
-    "default": ("runs/default/scene.toml", 0.5),
-    "iterated": ("runs/equal-density/fsi1.toml", 0.25),
-    "contact-drop": ("runs/contact-blocks/drop.toml", None),
-    "contact-blocks": ("runs/contact-blocks/blocks.toml", None),
-    "fibers-on-block": ("runs/fibers-on-block/scene.toml", 0.5),
-    "fiber-channel": ("runs/fiber-channel/scene.toml", 0.3),
+    "default": ("runs/default/scene.toml", 0.5, ""),
+    "iterated": ("runs/equal-density/fsi1.toml", 0.25, ""),
+    "iterated-cn": ("runs/neutral-disk/scene.toml", 0.3, ITERATIONS),
+    "contact-drop": ("runs/contact-blocks/drop.toml", None, ""),
+    "contact-blocks": ("runs/contact-blocks/blocks.toml", None, ""),
+    "fibers-on-block": ("runs/fibers-on-block/scene.toml", 0.5, ""),
+    "fiber-channel": ("runs/fiber-channel/scene.toml", 0.3, ""),
 }
 
 
@@ -91,14 +94,17 @@ def run(bin_dir, scene, out):
                  f"{r.stderr[-3000:]}")
 
 
-def shortened(scene, t_end):
-    """The scene with t_end replaced, written beside it (its relative mesh paths still hold)."""
-    if t_end is None:
+def shortened(scene, t_end, extra):
+    """The scene with t_end replaced and `extra` appended, written beside it (its relative mesh
+    paths still hold)."""
+    if t_end is None and not extra:
         return scene, False
-    text = open(scene).read()
-    new, n = re.subn(r"(?m)^t_end\s*=.*$", f"t_end = {t_end!r}", text, count=1)
-    if n != 1:
-        sys.exit(f"compare_outputs: no t_end line in {scene}")
+    new = open(scene).read()
+    if t_end is not None:
+        new, n = re.subn(r"(?m)^t_end\s*=.*$", f"t_end = {t_end!r}", new, count=1)
+        if n != 1:
+            sys.exit(f"compare_outputs: no t_end line in {scene}")
+    new += extra
     path = os.path.splitext(scene)[0] + "_compare.toml"
     with open(path, "w") as f:
         f.write(new)
@@ -125,8 +131,8 @@ def main():
     for name in a.scenes.split(","):
         if name not in SCENES:
             ap.error(f"unknown scene '{name}' (one of {', '.join(SCENES)})")
-        scene, t_end = SCENES[name]
-        scene, temporary = shortened(os.path.join(ROOT, scene), t_end)
+        scene, t_end, extra = SCENES[name]
+        scene, temporary = shortened(os.path.join(ROOT, scene), t_end, extra)
         try:
             outs = []
             for tag, bin_dir in (("a", a.bin_a), ("b", a.bin_b)):

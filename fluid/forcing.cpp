@@ -1,0 +1,35 @@
+// The immersed solid's forcing of the fluid (paper Eq. 21) on the predictor u~.
+#include "solver.hpp"
+
+namespace fluid {
+
+// Immersed solid (paper Eq. 21): f_s = rho_f alpha (u_s - u~) / dt, then u~ += dt f_s / rho_f,
+// i.e. u~ <- (1 - alpha) u~ + alpha u_s, on the solid's faces.
+void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out) {
+  const double rho = m_cfg.density;
+  const int nx = m_grid.nx(), ny = m_grid.ny();
+  out.solid_u_force.resize(in.solid_u_index.size());
+  out.solid_v_force.resize(in.solid_v_index.size());
+  for (std::size_t q = 0; q < in.solid_u_index.size(); ++q) {
+    const auto [i, j] = face_of(0, in.solid_u_index[q]);
+    double f = 0;
+    if (i >= m_i0 && i < nx) {
+      double& u = m_u(i, j);
+      f = rho * in.solid_u_alpha[q] * (in.solid_u_velocity[q] - u) / dt;
+      u += dt * f / rho;
+    }
+    out.solid_u_force[q] = f;
+  }
+  for (std::size_t q = 0; q < in.solid_v_index.size(); ++q) {
+    const auto [i, j] = face_of(1, in.solid_v_index[q]);
+    double f = 0;
+    if (j >= m_j0 && j < ny) {
+      double& v = m_v(i, j);
+      f = rho * in.solid_v_alpha[q] * (in.solid_v_velocity[q] - v) / dt;
+      v += dt * f / rho;
+    }
+    out.solid_v_force[q] = f;
+  }
+}
+
+}  // namespace fluid

@@ -1,0 +1,188 @@
+// The predictor u~ of the fractional step: the explicit terms, the explicit (AB2) predictor, the
+// Crank-Nicolson one (its right-hand side and its solve), and the fibers' force in either.
+#include <algorithm>
+
+#include "solver.hpp"
+
+namespace fluid {
+
+// H(u^n) into m_hu, m_hv: -div(u u) + nu lap(u) (explicit diffusion) or -div(u u) with L u^n into
+// m_lu, m_lv (Crank-Nicolson).
+void Solver::explicit_terms() {
+  const bool imp = m_cfg.implicit;
+  momentum_terms(m_grid, m_sponge, m_u, m_v, imp ? 0.0 : m_nu, m_i0, m_j0, m_hu, m_hv,
+                 imp ? &m_lu : nullptr, imp ? &m_lv : nullptr);
+}
+
+// Explicit predictor (AB2 for convection and diffusion, Euler on the first step):
+//   u~ = u^n + dt [ (1 + dt/(2 dt')) H^n - dt/(2 dt') H^{n-1} - G p^n / rho + f(t^{n+1/2}) / rho
+//                   + f_f / rho ],   H = -div(u u) + nu lap(u)
+// without the fibers' f_f / rho, which add_fiber_force() adds on their faces.
+void Solver::predictor(double dt, double t_half) {
+  const double c1 = m_step == 0 ? 1.0 : 1.0 + 0.5 * dt / m_dt_prev;
+  const double c0 = m_step == 0 ? 0.0 : -0.5 * dt / m_dt_prev;
+  const auto acc = body_acceleration(t_half);
+  const double ri = 1.0 / m_cfg.density;
+  const int nx = m_grid.nx(), ny = m_grid.ny();
+  const double* xdi = m_grid.x().di();
+  const double* ydi = m_grid.y().di();
+  for (int j = 0; j < ny; ++j) {
+    double* u = m_u.row(j);
+    const double* h = m_hu.row(j);
+    const double* ho = m_hu_old.row(j);
+    const double* p = m_p.row(j);
+    for (int i = m_i0; i < nx; ++i) {
+      u[i] += dt * (c1 * h[i] + c0 * ho[i] + acc[0] - ri * (p[i] - p[i - 1]) * xdi[i]);
+    }
+  }
+  for (int j = m_j0; j < ny; ++j) {
+    double* v = m_v.row(j);
+    const double* h = m_hv.row(j);
+    const double* ho = m_hv_old.row(j);
+    const double* p = m_p.row(j);
+    const double* ps = m_p.row(j - 1);
+    const double gy = ri * ydi[j];
+    for (int i = 0; i < nx; ++i) {
+      v[i] += dt * (c1 * h[i] + c0 * ho[i] + acc[1] - gy * (p[i] - ps[i]));
+    }
+  }
+}
+
+// u~ += dt f_f / rho on the fibers' faces (the explicit predictor's last term). Crank-Nicolson:
+// the same term in its right-hand side B (predictor_implicit).
+void Solver::add_fiber_force(double dt, const CouplingIn& in) {
+  const double ri = 1.0 / m_cfg.density;
+  const int nx = m_grid.nx(), ny = m_grid.ny();
+  if (m_cfg.implicit) {
+    const double scale = -1.0 / (0.5 * m_nu * dt);
+    for (int comp = 0; comp < 2; ++comp) {
+      const auto& idx = comp == 0 ? in.fiber_u_index : in.fiber_v_index;
+      const auto& frc = comp == 0 ? in.fiber_u_force : in.fiber_v_force;
+      const int ib = comp == 0 ? m_i0 : 0, jb = comp == 0 ? 0 : m_j0;
+      const int nt = (comp == 0 ? m_helm_u : m_helm_v)->nt();
+      for (std::size_t q = 0; q < idx.size(); ++q) {
+        const auto [i, j] = face_of(comp, idx[q]);
+        if (i < ib || i >= nx || j < jb || j >= ny) continue;
+        m_rhs[comp][buf_index(i, j, ib, jb, nt)] += scale * dt * ri * frc[q];
+      }
+    }
+    return;
+  }
+  for (std::size_t q = 0; q < in.fiber_u_index.size(); ++q) {
+    const auto [i, j] = face_of(0, in.fiber_u_index[q]);
+    if (i >= m_i0 && i < nx) m_u(i, j) += dt * ri * in.fiber_u_force[q];
+  }
+  for (std::size_t q = 0; q < in.fiber_v_index.size(); ++q) {
+    const auto [i, j] = face_of(1, in.fiber_v_index[q]);
+    if (j >= m_j0 && j < ny) m_v(i, j) += dt * ri * in.fiber_v_force[q];
+  }
+}
+
+// Crank-Nicolson predictor, theta = nu dt / 2:
+//   (I - theta L) u~ = B,
+//   B  = u^n + dt [AB2(-div(u u)) - G p^n / rho + f / rho + f_f / rho] + theta L u^n
+//        + theta b^{n+1},
+// with b^{n+1} the boundary data at t^{n+1}. L is solved as the fast solver's L0, which equals L
+// except in the transform direction next to a wall or an outflow, where L0 uses the nearest
+// closure a real transform diagonalises (ghost -q0 or +q0). The difference is carried
+// explicitly with u^n, so a steady state is that of L exactly; this is stable for
+// nu dt / h_t^2 < 2 (checked by validate()).
+//
+// The immersed solid's forcing acts on the solve's result, as the explicit scheme forces its
+// predictor (immersed_forcing).
+//
+// This assembles B (scaled by -1/theta, as the Helmholtz solver takes it) in the solver's layout
+// into m_rhs, which add_fiber_force() completes and solve_implicit() solves.
+void Solver::predictor_implicit(double dt, double t_half) {
+  const double c1 = m_step == 0 ? 1.0 : 1.0 + 0.5 * dt / m_dt_prev;
+  const double c0 = m_step == 0 ? 0.0 : -0.5 * dt / m_dt_prev;
+  const auto acc = body_acceleration(t_half);
+  const double ri = 1.0 / m_cfg.density;
+  const double theta = 0.5 * m_nu * dt, scale = -1.0 / theta;
+  const int nx = m_grid.nx(), ny = m_grid.ny();
+  const Axis& X = m_grid.x();
+  const Axis& Y = m_grid.y();
+
+  for (int comp = 0; comp < 2; ++comp) {
+    Field& F = comp == 0 ? m_u : m_v;
+    const Field& H = comp == 0 ? m_hu : m_hv;
+    const Field& Ho = comp == 0 ? m_hu_old : m_hv_old;
+    const Field& L = comp == 0 ? m_lu : m_lv;
+    const FastSolver& hs = comp == 0 ? *m_helm_u : *m_helm_v;
+    const int ib = comp == 0 ? m_i0 : 0, jb = comp == 0 ? 0 : m_j0;
+    const int nt = hs.nt();
+    std::vector<double>& buf = m_rhs[comp];
+    buf.resize(std::size_t(hs.nt()) * hs.ns());
+    const double* gd = comp == 0 ? X.di() : Y.di();
+    for (int j = jb; j < ny; ++j) {
+      const double* f = F.row(j);
+      const double* h = H.row(j);
+      const double* ho = Ho.row(j);
+      const double* l = L.row(j);
+      const double* p = m_p.row(j);
+      const double* pm = comp == 0 ? p - 1 : m_p.row(j - 1);  // p at the face's low side
+      for (int i = ib; i < nx; ++i) {
+        const double gp = (p[i] - pm[i]) * (comp == 0 ? gd[i] : gd[j]);
+        const double rhs =
+            f[i] + dt * (c1 * h[i] + c0 * ho[i] + acc[comp] - ri * gp) + theta * l[i];
+        const int k = buf_index(i, j, ib, jb, nt);
+        buf[k] = scale * rhs;
+      }
+    }
+    // Boundary rows: theta * coef * (value beyond the row at t^{n+1} - what the solved operator
+    // assumes there).
+    for (int s = 0; s < 4; ++s) {
+      const SideBc& bc = m_bnd.side(s);
+      if (bc.type == BcType::periodic) continue;
+      const int a = s / 2;
+      const bool hi = s % 2;
+      const Axis& ax = m_grid.axis(a);
+      const int n = ax.n();
+      const int kb = a == 0 ? jb : ib, ke = a == 0 ? ny : nx;  // range along the side
+      auto val = [&](int nidx, int k) { return a == 0 ? F(nidx, k) : F(k, nidx); };
+      auto add = [&](int nidx, int k, double x) {
+        const int i = a == 0 ? nidx : k, j = a == 0 ? k : nidx;
+        buf[buf_index(i, j, ib, jb, nt)] += scale * theta * x;
+      };
+      if (a == comp) {  // normal component: boundary face value
+        const int b = hi ? n : 0, f = hi ? n - 1 : 1;
+        const double coef = hi ? ax.wi()[n - 1] * ax.di()[n - 1] : ax.wi()[0] * ax.di()[1];
+        for (int k = kb; k < ke; ++k) add(f, k, coef * val(b, k));
+      } else {  // tangential component: ghost value
+        const int g = hi ? n : -1, q0 = hi ? n - 1 : 0, q1 = hi ? n - 2 : 1;
+        const double coef = hi ? ax.di()[n] * ax.ci()[n - 1] : ax.di()[0] * ax.ci()[0];
+        const GhostRule& r = m_bnd.rule(s);
+        const bool in_transform = a == m_t_axis;
+        const double sgn = bc.type == BcType::slip ? 1.0 : -1.0;
+        for (int k = kb; k < ke; ++k) {
+          const double assumed = in_transform ? sgn * val(q0, k)
+                                 : r.is_data  ? 0.0
+                                              : r.ga * val(q0, k) + r.gb * val(q1, k);
+          add(q0, k, coef * (val(g, k) - assumed));
+        }
+      }
+    }
+  }
+}
+
+// The Crank-Nicolson solve of the step: u~ = (I - theta L)^-1 B on the interior faces
+// (predictor_implicit); the immersed forcing follows on u~.
+void Solver::solve_implicit() {
+  const int nx = m_grid.nx(), ny = m_grid.ny();
+  for (int comp = 0; comp < 2; ++comp) {
+    Field& F = comp == 0 ? m_u : m_v;
+    FastSolver& hs = comp == 0 ? *m_helm_u : *m_helm_v;
+    const int ib = comp == 0 ? m_i0 : 0, jb = comp == 0 ? 0 : m_j0;
+    const int nt = hs.nt();
+    const std::vector<double>& rhs = m_rhs[comp];
+    double* buf = hs.data();
+    std::copy(rhs.begin(), rhs.end(), buf);
+    hs.solve();
+    for (int j = jb; j < ny; ++j) {
+      double* f = F.row(j);
+      for (int i = ib; i < nx; ++i) f[i] = buf[buf_index(i, j, ib, jb, nt)];
+    }
+  }
+}
+
+}  // namespace fluid

@@ -1,0 +1,76 @@
+// The projection of the fractional step: the pressure Poisson equation and the velocity
+// correction that makes u^(n+1) discretely divergence-free.
+#include "solver.hpp"
+#include "timer.hpp"
+
+namespace fluid {
+
+// Projection: L phi = (rho / dt) D u~ (Neumann at non-periodic sides), then
+//   u^{n+1} = u~ - (dt / rho) G phi,   p^{n+1} = p^n + phi.
+// D G is exactly the operator the fast solver inverts, so D u^{n+1} = 0 to round-off.
+void Solver::project(double dt) {
+  const int nx = m_grid.nx(), ny = m_grid.ny();
+  const double *xwi = m_grid.x().wi(), *ywi = m_grid.y().wi();
+  const double *xdi = m_grid.x().di(), *ydi = m_grid.y().di();
+  FastSolver& ps = *m_poisson;
+  double* buf = ps.data();
+  const int nt = ps.nt();
+  const double k = m_cfg.density / dt;
+  // The duplicate face of a periodic direction carries the value of face 0.
+  if (m_grid.x().periodic())
+    for (int j = 0; j < ny; ++j) m_u(nx, j) = m_u(0, j);
+  if (m_grid.y().periodic())
+    for (int i = 0; i < nx; ++i) m_v(i, ny) = m_v(i, 0);
+  for (int j = 0; j < ny; ++j) {
+    const double* u = m_u.row(j);
+    const double* v = m_v.row(j);
+    const double* vn = m_v.row(j + 1);
+    const double wy = ywi[j];
+    if (m_t_axis == 0) {
+      double* b = buf + std::size_t(nt) * j;
+      for (int i = 0; i < nx; ++i) b[i] = k * ((u[i + 1] - u[i]) * xwi[i] + (vn[i] - v[i]) * wy);
+    } else {
+      for (int i = 0; i < nx; ++i) {
+        buf[j + std::size_t(nt) * i] = k * ((u[i + 1] - u[i]) * xwi[i] + (vn[i] - v[i]) * wy);
+      }
+    }
+  }
+  {
+    const PhaseTimer t(m_time.poisson);
+    ps.solve();
+  }
+  const PhaseTimer t(m_time.projection);
+  for (int j = 0; j < ny; ++j) {
+    double* phi = m_phi.row(j);
+    double* p = m_p.row(j);
+    for (int i = 0; i < nx; ++i) {
+      phi[i] = buf[buf_index(i, j, 0, 0, nt)];
+      p[i] += phi[i];
+    }
+  }
+  m_bnd.fill_scalar(m_phi);
+  m_bnd.fill_scalar(m_p);
+  const double c = dt / m_cfg.density;
+  for (int j = 0; j < ny; ++j) {
+    double* u = m_u.row(j);
+    const double* phi = m_phi.row(j);
+    for (int i = m_i0; i < nx; ++i) u[i] -= c * (phi[i] - phi[i - 1]) * xdi[i];
+  }
+  for (int j = m_j0; j < ny; ++j) {
+    double* v = m_v.row(j);
+    const double* phi = m_phi.row(j);
+    const double* phs = m_phi.row(j - 1);
+    const double cy = c * ydi[j];
+    for (int i = 0; i < nx; ++i) v[i] -= cy * (phi[i] - phs[i]);
+  }
+}
+
+void Solver::project_initial() {
+  m_bnd.advance_normal(m_u, m_v, m_t, 0.0);
+  const Field p = m_p;
+  project(1.0);
+  m_p = p;
+  m_bnd.fill_ghosts(m_u, m_v);
+}
+
+}  // namespace fluid
