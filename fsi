@@ -129,7 +129,7 @@ run() {
   say "running: ${CMD[*]}"
   "${CMD[@]}"
   # Post-processing: the scene's own plot script if its folder has one, else the generic one.
-  local plot=$(dirname "$scene")/plot
+  local plot=$(dirname "$scene")/plot.py
   [ -x "$plot" ] || plot=$ROOT/runs/plot_run.py
   FSI_ROOT=$ROOT FSI_OUT=$dir /usr/bin/python3 "$plot" "$dir" || say "post-processing failed"
   say "output in ${dir#$ROOT/}/"
@@ -160,13 +160,13 @@ validate() {
   build
   local cases=("$@")
   if [ ${#cases[@]} -eq 0 ]; then
-    for d in "$ROOT"/runs/*/; do [ -x "$d/validate" ] && cases+=("$(basename "$d")"); done
+    for d in "$ROOT"/runs/*/; do [ -x "$d/validate.py" ] && cases+=("$(basename "$d")"); done
   fi
   [ ${#cases[@]} -gt 0 ] || die "no validation cases in runs/"
   local failed=()
   for c in "${cases[@]}"; do
-    local script=$ROOT/runs/$c/validate
-    [ -x "$script" ] || die "no validation case '$c' (runs/$c/validate); cases: $(cd "$ROOT/runs" && ls -d */ | tr -d /)"
+    local script=$ROOT/runs/$c/validate.py
+    [ -x "$script" ] || die "no validation case '$c' (runs/$c/validate.py); cases: $(cd "$ROOT/runs" && ls -d */ | tr -d /)"
     say "validating $c"
     mkdir -p "$ROOT/out/$c"
     if FSI_ROOT=$ROOT FSI_BIN=$BIN FSI_OUT=$ROOT/out/$c "$script"; then

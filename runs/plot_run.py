@@ -1,11 +1,11 @@
 #!/usr/bin/python3
 """Generic post-processing of a run folder: one PNG of every probe CSV's columns against time.
 
-usage: plot_run.py OUT_DIR    (./fsi run calls it when the scene's folder has no `plot` script)
+usage: plot_run.py [OUT_DIR]   (./fsi run calls it when the scene's folder has no plot.py)
 """
+import argparse
 import glob
 import os
-import sys
 
 import matplotlib
 
@@ -43,4 +43,6 @@ def main(out):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else ".")
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("out", nargs="?", default=".", help="the run's output folder")
+    main(p.parse_args().out)

@@ -12,7 +12,6 @@ finds the coupling's limit. Writes stability.json and stability.md into the outp
 import json
 import math
 import os
-import sys
 
 import h5py
 import numpy as np
@@ -162,9 +161,9 @@ def bisect(v, case):
             "runs": log}
 
 
-def main(v):
-    os.makedirs(v.OUT, exist_ok=True)
-    only = [c for c in CASES if f"--{c}" in sys.argv] or list(CASES)
+def main(v, only=None):
+    """Bisect the cases named in `only` (all when empty), v: the validate module."""
+    only = only or list(CASES)
     results = []
     for case in only:
         print(f"stability: {case}", flush=True)

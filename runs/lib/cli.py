@@ -1,0 +1,31 @@
+"""The command line of a case script: argparse with the script's docstring as its help, so that
+a misspelt option is an error."""
+import argparse
+
+
+def parser(doc, short=True):
+    """An ArgumentParser showing DOC; with short, the `--short` option every case has (the
+    quick version the test suite runs)."""
+    p = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    if short:
+        p.add_argument("--short", action="store_true", help="the short version (./fsi test)")
+    return p
+
+
+def ints(text):
+    """A comma-separated list of integers, for `type=`."""
+    try:
+        return [int(v) for v in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a comma-separated list of integers, got '{text}'")
+
+
+def positive(text):
+    """A number > 0, for `type=`."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a number, got '{text}'")
+    if not v > 0:
+        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+    return v

@@ -1,0 +1,22 @@
+"""What every program's output folder shares: CSV files with a header row (probes, histories,
+loads, forces), summary.json, and HDF5 files whose output steps are groups `step_<k>`."""
+import json
+import os
+
+import numpy as np
+
+
+def table(path):
+    """A CSV with a header row as a numpy record array (columns by name, dots kept: t["A.ux"])."""
+    return np.atleast_1d(np.genfromtxt(path, delimiter=",", names=True, deletechars=""))
+
+
+def summary(folder):
+    """A run's summary.json (settings, steps, wall time per program, the program's results)."""
+    with open(os.path.join(folder, "summary.json")) as f:
+        return json.load(f)
+
+
+def step_keys(h5):
+    """The output step groups of an open HDF5 file, in step order."""
+    return sorted((k for k in h5.keys() if k.startswith("step_")), key=lambda k: int(k.split("_")[1]))

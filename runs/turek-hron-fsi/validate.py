@@ -1,0 +1,435 @@
+#!/usr/bin/python3
+"""Turek-Hron FSI2 and FSI1 (Turek & Hron 2006; the paper's Sec. 4.2) through the coupled job
+(fluid + solid + coupler): an elastic St.Venant-Kirchhoff bar clamped behind the fixed cylinder.
+
+FSI2 (rho_s = 10 rho_f, mean inflow 1): periodic flapping. Point A's displacement comes from the
+solid's probe CSV (solid_probes.csv, columns A.ux, A.uy), drag and lift of cylinder + bar from
+coupler_forces.csv (total.fx, total.fy). Over the last two seconds each history is summarised as
+mean +- amplitude (mean = (max + min)/2, amplitude = (max - min)/2), the benchmark's definition,
+with the frequency of the spectral peak over the last 6 s, and compared with the reference.
+Levels (grid, dt, bar mesh) form the speed-against-error table (levels.md).
+
+FSI1 (mean inflow 0.2, Re 20): steady. Its steady state does not depend on the solid's density,
+but the coupling's stability does: the benchmark's rho_s = rho_f = 1000 is run to show what
+happens (it is refused as growth, see README), and the steady values are measured with
+rho_s = 10 rho_f (only the transient differs).
+
+  validate            FSI2 on levels L2, L3, L4 and FSI1 (about 20 min on 2 cores)
+  validate --short    FSI2 on L2 only (about 1.5 min alone; fails on the 2.0 Hz frequency)
+  validate --ci       as --short, the amplitude judged against both references, the frequency
+                      against the refined 1.93 Hz and reported against 2.0 Hz (./fsi test)
+  validate --coarse   FSI2 on L1 (250 x 41) with coupled iterations (explicit, L1 does not hold)
+  validate --dt-limit FSI2 on L2 at growing dt: the largest stable step
+  validate --fsi1-level L4   FSI1 on another level (default L2); --fsi1-only: FSI1 alone
+  validate --fsi1-grids FSI1 on four fluid grids with one bar mesh, to t = 8 (about 15 min)
+  validate --reuse    keep a run whose folder has a summary.json from the identical scene text
+Environment (set by ./fsi validate): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN."""
+import json
+import os
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import cli  # noqa: E402
+import couplerout  # noqa: E402
+import h5py  # noqa: E402
+import job  # noqa: E402
+import matplotlib  # noqa: E402
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.tri as mtri  # noqa: E402
+import numpy as np  # noqa: E402
+import outputs  # noqa: E402
+import solidout  # noqa: E402
+from metrics import finish, metric, reported  # noqa: E402
+
+_p = cli.parser(__doc__)
+_p.add_argument("--ci", action="store_true", help="as --short, the frequency against the refined value")
+_p.add_argument("--coarse", action="store_true", help="FSI2 on L1 with coupled iterations")
+_p.add_argument("--dt-limit", action="store_true", help="FSI2 on L2 at growing dt")
+_p.add_argument("--fsi1-level", default="L2", help="FSI1's level (L2)")
+_p.add_argument("--fsi1-only", action="store_true", help="FSI1 alone")
+_p.add_argument("--fsi1-grids", action="store_true", help="FSI1 on four fluid grids")
+_p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
+ARGS = _p.parse_args()
+# --ci: L2 only, the frequency judged against the refined values and reported against the 2006
+# table's 2.0 Hz, which this method misses by 3.4-3.5 % on every level (README, "Frequency").
+CI = ARGS.ci
+SHORT = ARGS.short or CI
+REUSE = ARGS.reuse
+COARSE = ARGS.coarse
+HERE = os.path.dirname(os.path.abspath(__file__))
+OUT = job.out_dir("turek-hron-fsi")
+H, L = 0.41, 2.5
+
+# Turek & Hron (2006), Table "FSI2" and "FSI1" (reference.csv, with the source).
+def read_reference():
+    rows = [ln for ln in open(os.path.join(HERE, "reference.csv")) if not ln.startswith("#")]
+    head = rows[0].strip().split(",")
+    ref = {}
+    for ln in rows[1:]:
+        r = dict(zip(head, ln.strip().split(",")))
+        ref[(r["case"], r["quantity"])] = {k: float(r[k]) for k in ("mean", "amplitude", "frequency")}
+    return ref
+
+
+REF = read_reference()
+QUANTITIES = [("A.ux", "ux", 1.0), ("A.uy", "uy", 1.0), ("total.fx", "drag", 1.0),
+              ("total.fy", "lift", 1.0)]
+# Levels: fluid cells across the channel, dt, bar cells (length x thickness, criss-cross).
+# The bar's thickness 0.02 takes 4, 8, 12 elements: linear triangles are stiff in bending, and
+# 8 across puts the static deflection within about 3 % (CSM1, runs/turek-hron-csm).
+LEVELS = {
+    "L1": {"n": 41, "dt": 5e-4, "bar": [70, 4]},
+    # L1 with coupled iterations: the explicit step does not hold the bar two cells thick (README).
+    "L1i": {"n": 41, "dt": 5e-4, "bar": [70, 4], "iterations": True},
+    "L2": {"n": 82, "dt": 5e-4, "bar": [140, 8]},
+    "L3": {"n": 82, "dt": 2.5e-4, "bar": [140, 8]},
+    "L4": {"n": 123, "dt": 2.5e-4, "bar": [210, 12]},
+}
+
+RUN_LEVELS = ["L2"] if SHORT else (["L1i"] if COARSE else ["L2", "L3", "L4"])
+# The coupled iterations of level L1i (coupler/README.md): about two passes per step.
+ITERATIONS = """
+[coupler.iterations]
+max = 20
+tolerance = 1e-5
+relaxation = 0.5
+reuse = 10
+"""
+T_END = 12.0  # the flapping is periodic from t = 6 (measured on L3: amplitudes change < 0.1 %)
+WINDOW = 2.0
+# Tolerances, fixed before the runs: u_y(A) amplitude 5 %, its frequency 3 %.
+TOL = {"amplitude": 0.05, "frequency": 0.03}
+
+
+def scene_text(case, level, dt=None, rho_s=None, t_end=None):
+    lv = LEVELS[level]
+    n = lv["n"]
+    h = H / n
+    nx = int(round(L / h))
+    dt = lv["dt"] if dt is None else dt
+    t_end = T_END if t_end is None else t_end
+    replace = {
+        "name": f'name = "{case}-{level}"',
+        "cells": f"cells = [{nx}, {n}]",
+        "dt": f"dt = {dt:.10g}",
+        "t_end": f"t_end = {t_end:g}",
+        "mesh_parameters": f'mesh_parameters = "lc = {h:.10g}"',
+        "rectangle": "rectangle = { origin = [0.24899, 0.19], size = [0.35101, 0.02], "
+                     f"cells = [{lv['bar'][0]}, {lv['bar'][1]}] }}",
+    }
+    lines, section = [], ""
+    for line in open(os.path.join(HERE, f"{case}.toml")).read().splitlines():
+        key = line.split("=")[0].strip()
+        if line.startswith("["):
+            section = line.strip()
+        if key in replace:
+            line = replace.pop(key)
+        elif key == "mesh":
+            line = f'mesh = "{os.path.join(HERE, "cylinder.geo")}"'
+        elif key == "density" and rho_s is not None and section == "[[solid.body.material]]":
+            line = f"density = {rho_s:g}"
+        lines.append(line)
+    assert not replace, f"scene {case}.toml lacks keys {list(replace)}"
+    return "\n".join(lines) + "\n" + (ITERATIONS if lv.get("iterations") else "")
+
+
+def run(name, text, expect_fail=False):
+    """Run fluid + solid + coupler on the scene into OUT/name: (folder, wall s, log), the log
+    being the job's output when it failed (allowed with expect_fail), else ""."""
+    r = job.run(name, text, check=not expect_fail, reuse=REUSE and not expect_fail)
+    return r.folder, r.wall, r.log if r.returncode != 0 else ""
+
+
+def histories(folder):
+    p = solidout.probes(folder)
+    f = couplerout.forces(folder)
+    out = {}
+    for col, q, _ in QUANTITIES:
+        d = p if col.startswith("A.") else f
+        out[q] = (d["time"], d[col])
+    return out
+
+
+SPECTRUM_WINDOW = 6.0  # seconds of the periodic regime for the frequency
+
+
+def analyse(t, y, window=WINDOW):
+    """Mean +- amplitude over the last `window` seconds (see the module's doc); the frequency is
+    the highest peak of the spectrum of the last SPECTRUM_WINDOW seconds (Hann window, zero
+    padded 16x, parabolic interpolation of the peak), which also serves histories such as the
+    drag that cross their mean more than twice a period."""
+    w = t >= t[-1] - window
+    yw = y[w]
+    lo, hi = yw.min(), yw.max()
+    mean, amp = 0.5 * (hi + lo), 0.5 * (hi - lo)
+    freq = 0.0
+    s = t >= t[-1] - min(SPECTRUM_WINDOW, t[-1] - t[0])
+    ts, ys = t[s], y[s]
+    if len(ts) > 16 and amp > 1e-9 * max(abs(mean), 1.0):
+        dt = (ts[-1] - ts[0]) / (len(ts) - 1)
+        nfft = 16 * len(ts)
+        a = np.abs(np.fft.rfft((ys - ys.mean()) * np.hanning(len(ys)), nfft))
+        f = np.fft.rfftfreq(nfft, dt)
+        k = int(np.argmax(a[1:])) + 1
+        if 0 < k < len(a) - 1:
+            l, c, r = np.log(a[k - 1] + 1e-300), np.log(a[k] + 1e-300), np.log(a[k + 1] + 1e-300)
+            d = 0.5 * (l - r) / (l - 2 * c + r) if l - 2 * c + r != 0 else 0.0
+            freq = float(f[k] + d * (f[1] - f[0]))
+        else:
+            freq = float(f[k])
+    return {"mean": float(mean), "amplitude": float(amp), "frequency": float(freq),
+            "last": float(y[-1])}
+
+
+def rel(value, reference):
+    return abs(value - reference) / abs(reference) if reference != 0 else float("nan")
+
+
+def spectrum(t, y, t0):
+    w = t >= t0
+    tt, yy = t[w], y[w] - y[w].mean()
+    dt = np.median(np.diff(tt))
+    amp = np.abs(np.fft.rfft(yy * np.hanning(len(yy)))) * 2 / (0.5 * len(yy))
+    return np.fft.rfftfreq(len(yy), dt), amp
+
+
+def picture(folder, title, path):
+    """Vorticity at the last output step with the bar's mesh and the cylinder."""
+    with h5py.File(os.path.join(folder, "fluid.h5"), "r") as f, \
+            h5py.File(os.path.join(folder, "solid.h5"), "r") as s:
+        last = [k for k in outputs.step_keys(f) if k in s][-1]
+        w = np.array(f[last]["vorticity"])
+        t = float(f[last].attrs.get("time", float("nan")))
+        fig, ax = plt.subplots(figsize=(11, 2.4))
+        lim = np.percentile(np.abs(w), 99)
+        ax.imshow(w, origin="lower", extent=[0, L, 0, H], cmap="RdBu_r", vmin=-lim, vmax=lim,
+                  interpolation="nearest", aspect="equal")
+        for name in (k for k in s.keys() if k.startswith("body_")):
+            tri = s[name]["triangles"][:]
+            x = s[last][name]["position"][:]
+            ax.triplot(mtri.Triangulation(x[:, 0], x[:, 1], tri), color="k", lw=0.25)
+        ax.set_xlim(0, 1.2)
+        ax.set_title(f"{title}, t = {t:.3g}", fontsize=9)
+        fig.tight_layout()
+        fig.savefig(path, dpi=140)
+        plt.close(fig)
+
+
+def fsi2(metrics, rows):
+    fig, axes = plt.subplots(4, 1, figsize=(10, 10), sharex=True)
+    sfig, saxes = plt.subplots(1, 2, figsize=(10, 3.5))
+    for level in RUN_LEVELS:
+        lv = LEVELS[level]
+        folder, wall, _ = run(f"fsi2-{level}", scene_text("fsi2", level))
+        hist = histories(folder)
+        res = {q: analyse(*hist[q]) for q in hist}
+        # The forces carry a jitter from faces whose volume fraction changes as the bar crosses
+        # the grid (spikes of a few steps, visible in fsi2_histories.png); a 10 ms moving average
+        # removes it and damps the 3.9 Hz drag fundamental by a factor sin(x)/x = 0.998 only.
+        for q in ("drag", "lift"):
+            t, y = hist[q]
+            n = max(1, int(round(0.01 / (t[1] - t[0]))))
+            ys = np.convolve(y, np.ones(n) / n, mode="valid")
+            res[q + "_smoothed"] = analyse(t[n // 2:n // 2 + len(ys)], ys)
+        steps = outputs.summary(folder)["steps"]
+        row = {"level": level, "cells": [int(round(L * lv["n"] / H)), lv["n"]], "dt": lv["dt"],
+               "bar_cells": lv["bar"], "steps": steps, "wall_s": wall, "results": res,
+               "errors": {}}
+        row["errors_refined"] = {}
+        for _, q, _ in QUANTITIES:
+            for key, case in (("errors", "fsi2"), ("errors_refined", "fsi2-refined")):
+                ref = REF[(case, q)]
+                row[key][q] = {"mean": rel(res[q]["mean"], ref["mean"]),
+                               "amplitude": rel(res[q]["amplitude"], ref["amplitude"]),
+                               "frequency": rel(res[q]["frequency"], ref["frequency"])}
+        rows.append(row)
+        e = row["errors"]
+        print(f"FSI2 {level} ({row['cells'][0]} x {row['cells'][1]}, dt {lv['dt']:g}, bar "
+              f"{lv['bar'][0]} x {lv['bar'][1]}, {steps} steps, {wall:.0f} s): "
+              + "; ".join(f"{q} {res[q]['mean']:.4g} +- {res[q]['amplitude']:.4g} "
+                          f"[{res[q]['frequency']:.3f}] (mean {100 * e[q]['mean']:.1f} %, amp "
+                          f"{100 * e[q]['amplitude']:.1f} %, f {100 * e[q]['frequency']:.1f} %)"
+                          for _, q, _ in QUANTITIES), flush=True)
+        for k, (_, q, _) in enumerate(QUANTITIES):
+            t, y = hist[q]
+            axes[k].plot(t, y, lw=0.6, label=level)
+            if q in ("uy", "lift"):
+                fr, a = spectrum(t, y, t[-1] - 4.0)
+                saxes[0 if q == "uy" else 1].plot(fr, a, lw=0.8, label=level)
+        picture(folder, f"FSI2 {level} vorticity", os.path.join(OUT, f"fsi2_{level}_vorticity.png"))
+    for k, (_, q, _) in enumerate(QUANTITIES):
+        ref = REF[("fsi2", q)]
+        for s in (-1, 1):
+            axes[k].axhline(ref["mean"] + s * ref["amplitude"], color="k", ls=":", lw=0.8)
+        axes[k].set_ylabel(q)
+        axes[k].legend(fontsize=7, loc="upper left")
+    axes[-1].set_xlabel("t [s]")
+    axes[0].set_title("FSI2: point A and forces (dotted: Turek & Hron mean +- amplitude)")
+    fig.tight_layout()
+    fig.savefig(os.path.join(OUT, "fsi2_coarse_histories.png" if COARSE else "fsi2_histories.png"), dpi=110)
+    plt.close(fig)
+    for ax, q in zip(saxes, ("uy", "lift")):
+        ax.axvline(REF[("fsi2", q)]["frequency"], color="k", ls=":", lw=0.8, label="Turek & Hron 2006")
+        ax.axvline(REF[("fsi2-refined", q)]["frequency"], color="k", ls="--", lw=0.8,
+                   label="refined (FEATFLOW)")
+        ax.set_xlim(0, 12)
+        ax.set_xlabel("f [Hz]")
+        ax.set_title(f"FSI2 spectrum of {q} (last 4 s)", fontsize=9)
+        ax.legend(fontsize=7)
+    sfig.tight_layout()
+    sfig.savefig(os.path.join(OUT, "fsi2_coarse_spectra.png" if COARSE else "fsi2_spectra.png"), dpi=110)
+    plt.close(sfig)
+    # Judged on the finest level run, against the 2006 table (the case's reference) and, reported
+    # beside it with the same tolerances, against the authors' refined values (reference.csv).
+    best = rows[-1]
+    for what in ("amplitude", "frequency"):
+        for suffix, case, key in (("", "fsi2", "errors"), ("_refined", "fsi2-refined", "errors_refined")):
+            err = best[key]["uy"][what]
+            judged = not (CI and what == "frequency" and case == "fsi2")
+            metrics[f"fsi2_uy_{what}{suffix}"] = metric(best["results"]["uy"][what],
+                                                        REF[(case, "uy")][what], err,
+                                                        TOL[what] if judged else None)
+    for q in ("ux", "drag", "lift", "drag_smoothed", "lift_smoothed"):
+        ref = REF[("fsi2", q.replace("_smoothed", ""))]
+        for what in ("mean", "amplitude", "frequency"):
+            v = best["results"][q][what]
+            metrics[f"fsi2_{q}_{what}"] = reported(v, ref[what])
+
+
+FSI1_LEVEL = ARGS.fsi1_level
+
+
+def fsi1(metrics, extra):
+    level = FSI1_LEVEL
+    # The benchmark's densities: rho_s = rho_f (zero excess mass).
+    folder, wall, log = run("fsi1-equal-density", scene_text("fsi1", level, t_end=4.0),
+                            expect_fail=True)
+    stopped = [ln for ln in log.splitlines() if "ERROR" in ln]
+    extra["fsi1_equal_density"] = {"completed": not log, "wall_s": wall,
+                                   "message": stopped[0] if stopped else ""}
+    print("FSI1 rho_s = rho_f:", "completed" if not log else f"stopped: {stopped[0] if stopped else log[-300:]}")
+    # The steady state with rho_s = 10 rho_f.
+    folder, wall, _ = run(f"fsi1-{level}", scene_text("fsi1", level, rho_s=10000.0, t_end=T_FSI1))
+    hist = histories(folder)
+    for q in ("ux", "uy", "drag", "lift"):
+        a = analyse(*hist[q])
+        ref = REF[("fsi1", q)]["mean"]
+        err = rel(a["last"], ref)
+        metrics[f"fsi1_{q}"] = metric(a["last"], ref, err,
+                                      0.05 if q in ("uy", "drag", "lift") else None)
+        metrics[f"fsi1_{q}"]["drift_over_window"] = a["amplitude"]
+        print(f"FSI1 {level} rho_s = 10 rho_f: {q} {a['last']:.5g} (reference {ref:.5g}, "
+              f"{100 * err:.2f} %, drift {a['amplitude']:.2g})", flush=True)
+
+
+T_FSI1 = 14.0
+
+
+def dt_limit():
+    """FSI2 on L2 from t = 0 to 6 at growing dt (the flapping has begun by t = 5)."""
+    rows = []
+    for dt in [5e-4, 1e-3, 1.5e-3, 2e-3, 3e-3]:
+        name = f"dtlimit-{dt:g}"
+        folder, wall, log = run(name, scene_text("fsi2", "L2", dt=dt, t_end=6.0), expect_fail=True)
+        msg = [ln for ln in log.splitlines() if "ERROR" in ln]
+        r = {"dt": dt, "completed": not log, "wall_s": wall, "message": msg[0] if msg else ""}
+        if not log:
+            r["uy"] = analyse(*histories(folder)["uy"], window=1.0)
+        rows.append(r)
+        print(f"dt {dt:g}: {'completed' if not log else 'stopped: ' + (msg[0] if msg else '?')}"
+              + (f", u_y(A) {r['uy']['mean']:.4g} +- {r['uy']['amplitude']:.4g}" if not log else ""),
+              flush=True)
+    with open(os.path.join(OUT, "dt_limit.json"), "w") as f:
+        json.dump(rows, f, indent=2)
+
+
+def fsi1_grids():
+    """FSI1 (rho_s = 10 rho_f) on 82, 123, 164 and 246 rows with the same bar mesh (140 x 8): the
+    fluid grid changes, and with it lambda = nu dt / h^2 (0.02 ... 0.09). The tip deflection is
+    0.19 to 0.55 of a cell on these grids, where the forcing's response to a sub-cell
+    displacement is far from proportional (runs/sub-cell-wall). To t = 8 (the L2 value is within
+    0.2 % of its t = 14 value there); the change over the last 0.5 s is reported."""
+    rows = []
+    for n in [82, 123, 164, 246]:
+        level = f"G{n}"
+        # dt 5e-4; 2.5e-4 on 246 rows, below the explicit diffusion limit h^2 / (8 nu) = 3.5e-4.
+        LEVELS[level] = {"n": n, "dt": 2.5e-4 if n > 200 else 5e-4, "bar": [140, 8]}
+        folder, wall, _ = run(f"fsi1-grid-{n}", scene_text("fsi1", level, rho_s=10000.0, t_end=8.0))
+        hist = histories(folder)
+        r = {"rows": n, "h": H / n, "dt": LEVELS[level]["dt"],
+             "lambda": 1e-3 * LEVELS[level]["dt"] / (H / n) ** 2, "wall_s": wall}
+        for q in ("ux", "uy", "drag", "lift"):
+            t, y = hist[q]
+            last = float(y[-1])
+            ref = REF[("fsi1", q)]["mean"]
+            r[q] = {"value": last, "reference": ref, "error": last / ref - 1.0,
+                    "change_over_last_0.5_s": last - float(np.interp(t[-1] - 0.5, t, y))}
+        r["tip_deflection_in_cells"] = r["uy"]["value"] / r["h"]
+        rows.append(r)
+        print(f"FSI1 on {n} rows: u_y(A) {1e3 * r['uy']['value']:.4f} mm "
+              f"({100 * r['uy']['error']:+.1f} %, {r['tip_deflection_in_cells']:.2f} cells), "
+              f"lift {r['lift']['value']:.4f} ({100 * r['lift']['error']:+.1f} %), "
+              f"drag {r['drag']['value']:.3f} ({100 * r['drag']['error']:+.1f} %), {wall:.0f} s",
+              flush=True)
+    with open(os.path.join(OUT, "fsi1_grids.json"), "w") as f:
+        json.dump(rows, f, indent=2)
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    hh = [1e3 * r["h"] for r in rows]
+    for q, label in (("uy", "u_y(A)"), ("lift", "lift"), ("drag", "drag")):
+        ax.plot(hh, [100 * r[q]["error"] for r in rows], "o-", label=label)
+    ax.axhline(0, color="gray", lw=0.5)
+    ax.set_xlabel("grid spacing h [mm] (bar 140 x 8 on every grid)")
+    ax.set_ylabel("error against Turek & Hron [%]")
+    ax.set_title("FSI1 against the fluid grid")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(OUT, "fsi1_grids.png"), dpi=120)
+
+
+def write_levels(rows):
+    with open(os.path.join(OUT, "levels-coarse.md" if COARSE else "levels.md"), "w") as f:
+        f.write("Errors against Turek & Hron (2006); in brackets against the refined FEATFLOW values "
+                "(reference.csv).\n\n")
+        f.write("| level | grid | dt | bar | steps | u_y(A) amp | err | u_y f | err | u_x(A) mean | err "
+                "| drag mean +- amp | err (mean, amp) | lift amp | err | 10 ms average: drag, lift amp | wall s |\n")
+        f.write("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+        for r in rows:
+            res, e, g = r["results"], r["errors"], r["errors_refined"]
+
+            def pc(q, what):
+                return f"{100 * e[q][what]:.1f} % ({100 * g[q][what]:.1f} %)"
+
+            f.write(f"| {r['level']} | {r['cells'][0]} x {r['cells'][1]} | {r['dt']:g} | "
+                    f"{r['bar_cells'][0]} x {r['bar_cells'][1]} | {r['steps']} | "
+                    f"{1e3 * res['uy']['amplitude']:.2f}e-3 | {pc('uy', 'amplitude')} | "
+                    f"{res['uy']['frequency']:.3f} | {pc('uy', 'frequency')} | "
+                    f"{1e3 * res['ux']['mean']:.2f}e-3 | {pc('ux', 'mean')} | "
+                    f"{res['drag']['mean']:.1f} +- {res['drag']['amplitude']:.1f} | "
+                    f"{pc('drag', 'mean')}, {pc('drag', 'amplitude')} | "
+                    f"{res['lift']['amplitude']:.1f} | {pc('lift', 'amplitude')} | "
+                    f"{res['drag_smoothed']['mean']:.1f} +- {res['drag_smoothed']['amplitude']:.1f}, "
+                    f"{res['lift_smoothed']['amplitude']:.1f} | "
+                    f"{r['wall_s']:.0f} |\n")
+
+
+def main():
+    if ARGS.dt_limit:
+        dt_limit()
+        return
+    if ARGS.fsi1_grids:
+        fsi1_grids()
+        return
+    metrics, rows, extra = {}, [], {}
+    if not ARGS.fsi1_only:
+        fsi2(metrics, rows)
+        write_levels(rows)
+    if not SHORT and not COARSE:
+        fsi1(metrics, extra)
+    extra["levels"] = rows
+    finish("turek-hron-fsi", metrics, extra, short=SHORT,
+           name="summary-coarse.json" if COARSE else "summary.json")
+
+
+if __name__ == "__main__":
+    main()
