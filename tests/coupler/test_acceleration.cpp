@@ -1,11 +1,11 @@
-// The coupler's acceleration of the coupled iterations (coupler.hpp, Acceleration) on linear
+// The coupler's acceleration of the coupled iterations (acceleration.hpp) on linear
 // fixed points x = J x + c with a known solution: IQN-ILS, Aitken and constant relaxation.
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <random>
 
-#include "coupler.hpp"
+#include "acceleration.hpp"
 
 using coupler::Acceleration;
 using coupler::IterationSettings;
