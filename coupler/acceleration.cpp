@@ -1,7 +1,6 @@
-// The acceleration of the coupled iterations (acceleration.hpp).
+// IQN-ILS, the acceleration of the coupled iterations (acceleration.hpp).
 #include "acceleration.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -13,12 +12,11 @@ namespace coupler {
 void Acceleration::begin_step() {
   m_k = 0;
   m_now = {};
-  m_omega = m_s.relaxation;
   m_columns = 0;
 }
 
 void Acceleration::end_step(bool converged) {
-  if (m_s.method != IterationSettings::Method::iqn_ils || m_s.reuse == 0) return;
+  if (m_s.reuse == 0) return;
   // A step that did not converge may hold nearly dependent pairs (a steady state: differences of
   // velocities at the tolerance's floor) that would steer the next steps' least squares far off:
   // forget every kept pair and start the next step from the relaxation alone.
@@ -38,17 +36,7 @@ void Acceleration::update(const std::vector<double>& x, const std::vector<double
   std::vector<double> r(n);
   for (std::size_t i = 0; i < n; ++i) r[i] = xt[i] - x[i];
   next.resize(n);
-  using Method = IterationSettings::Method;
-  if (m_k > 0 && m_s.method == Method::aitken) {
-    // w_k = -w_(k-1) r^(k-1).(r^k - r^(k-1)) / |r^k - r^(k-1)|^2, bounded.
-    double num = 0, den = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double d = r[i] - m_r_prev[i];
-      num += m_r_prev[i] * d, den += d * d;
-    }
-    if (den > 0) m_omega = std::clamp(-m_omega * num / den, -kAitkenMax, kAitkenMax);
-  }
-  if (m_k > 0 && m_s.method == Method::iqn_ils) {
+  if (m_k > 0) {
     std::vector<double> dv(n), dw(n);
     for (std::size_t i = 0; i < n; ++i) dv[i] = r[i] - m_r_prev[i], dw[i] = xt[i] - m_xt_prev[i];
     m_now.v.insert(m_now.v.begin(), std::move(dv));
@@ -58,47 +46,44 @@ void Acceleration::update(const std::vector<double>& x, const std::vector<double
   m_xt_prev = xt;
   ++m_k;
 
-  // The columns, newest first: this step's, then the kept steps'. Filter: modified
-  // Gram-Schmidt (twice) against the kept ones; a column whose orthogonal part is below
-  // kFilter of its length adds nothing the newer ones do not say, and is dropped for good.
+  // The columns, newest first: this step's, then the kept steps'. Filter: modified Gram-Schmidt
+  // (twice) against the kept ones; a column below kFilter is dropped for good.
   std::vector<std::pair<Pairs*, std::size_t>> cols;
-  if (m_s.method == Method::iqn_ils) {
-    std::vector<std::vector<double>> q;
-    auto consider = [&](Pairs& p) {
-      for (std::size_t c = 0; c < p.v.size();) {
-        if (q.size() >= n) {  // as many columns as unknowns: the rest cannot help
-          p.v.erase(p.v.begin() + c), p.w.erase(p.w.begin() + c);
-          continue;
-        }
-        std::vector<double> a = p.v[c];
-        double len = 0;
-        for (double z : a) len += z * z;
-        len = std::sqrt(len);
-        for (int pass = 0; pass < 2; ++pass)
-          for (const auto& b : q) {
-            double d = 0;
-            for (std::size_t i = 0; i < n; ++i) d += a[i] * b[i];
-            for (std::size_t i = 0; i < n; ++i) a[i] -= d * b[i];
-          }
-        double rest = 0;
-        for (double z : a) rest += z * z;
-        rest = std::sqrt(rest);
-        if (!(len > 0) || rest < kFilter * len) {
-          p.v.erase(p.v.begin() + c), p.w.erase(p.w.begin() + c);
-          continue;
-        }
-        for (double& z : a) z /= rest;
-        q.push_back(std::move(a));
-        cols.push_back({&p, c});
-        ++c;
+  std::vector<std::vector<double>> q;
+  auto consider = [&](Pairs& p) {
+    for (std::size_t c = 0; c < p.v.size();) {
+      if (q.size() >= n) {  // as many columns as unknowns: the rest cannot help
+        p.v.erase(p.v.begin() + c), p.w.erase(p.w.begin() + c);
+        continue;
       }
-    };
-    consider(m_now);
-    for (auto& p : m_old) consider(p);
-  }
+      std::vector<double> a = p.v[c];
+      double len = 0;
+      for (double z : a) len += z * z;
+      len = std::sqrt(len);
+      for (int pass = 0; pass < 2; ++pass)
+        for (const auto& b : q) {
+          double d = 0;
+          for (std::size_t i = 0; i < n; ++i) d += a[i] * b[i];
+          for (std::size_t i = 0; i < n; ++i) a[i] -= d * b[i];
+        }
+      double rest = 0;
+      for (double z : a) rest += z * z;
+      rest = std::sqrt(rest);
+      if (!(len > 0) || rest < kFilter * len) {
+        p.v.erase(p.v.begin() + c), p.w.erase(p.w.begin() + c);
+        continue;
+      }
+      for (double& z : a) z /= rest;
+      q.push_back(std::move(a));
+      cols.push_back({&p, c});
+      ++c;
+    }
+  };
+  consider(m_now);
+  for (auto& p : m_old) consider(p);
   m_columns = static_cast<int>(cols.size());
   if (cols.empty()) {
-    for (std::size_t i = 0; i < n; ++i) next[i] = x[i] + m_omega * r[i];
+    for (std::size_t i = 0; i < n; ++i) next[i] = x[i] + m_s.relaxation * r[i];
     return;
   }
   // c = argmin |V c + r| by Householder QR; x^(k+1) = x~^k + W c.

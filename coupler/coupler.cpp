@@ -51,10 +51,8 @@ void Coupler::read_iterations(const fsi::SceneTable& t) {
   m_iter.max = static_cast<int>(t.positive_integer("max", 1));
   if (m_iter.max > 1000) t.fail("max", fmt::format("must be <= 1000, got {}", m_iter.max));
   m_iter.tolerance = t.in_range("tolerance", 0.0, 1.0, true, 1e-6);
-  const std::string a = t.choice("acceleration", {"iqn-ils", "aitken", "constant"}, "iqn-ils");
-  m_iter.method = a == "aitken"     ? IterationSettings::Method::aitken
-                  : a == "constant" ? IterationSettings::Method::constant
-                                    : IterationSettings::Method::iqn_ils;
+  // IQN-ILS is the one method: the key is still accepted so that scenes naming it keep running.
+  t.choice("acceleration", {"iqn-ils"}, "iqn-ils");
   m_iter.relaxation = t.in_range("relaxation", 0.0, 1.0, false, 0.5);
   if (!(m_iter.relaxation > 0)) t.fail("relaxation", "must be in (0, 1], got 0");
   const long reuse = t.integer("reuse", 0);
@@ -715,13 +713,9 @@ void Coupler::finish() {
   j["coupler"]["us_per_step"] = 1e6 * loop / s.steps;
   j["coupler"]["phases"] = nlohmann::json::parse(m_phases.to_json().dump());
   if (m_accel) {
-    const char* method = m_iter.method == IterationSettings::Method::aitken     ? "aitken"
-                         : m_iter.method == IterationSettings::Method::constant ? "constant"
-                                                                                : "iqn-ils";
     j["coupler"]["iterations"] = {
         {"max", m_iter.max},
         {"tolerance", m_iter.tolerance},
-        {"acceleration", method},
         {"relaxation", m_iter.relaxation},
         {"reuse", m_iter.reuse},
         {"total", m_iter_total},
