@@ -1,11 +1,10 @@
 // IQN-ILS, the acceleration of the coupled iterations (acceleration.hpp).
 #include "acceleration.hpp"
 
-#include <cmath>
-#include <utility>
-
 #include <Eigen/Core>
 #include <Eigen/QR>
+#include <cmath>
+#include <utility>
 
 namespace coupler {
 

@@ -29,7 +29,8 @@ class Acceleration {
   static constexpr double kFilter = 1e-3;
   explicit Acceleration(const IterationSettings& s) : m_s(s) {}
   void begin_step();
-  void update(const std::vector<double>& x, const std::vector<double>& xt, std::vector<double>& next);
+  void update(const std::vector<double>& x, const std::vector<double>& xt,
+              std::vector<double>& next);
   // The step is over: a converged step's secant pairs join the kept ones (reuse); a step that did
   // not converge clears them all.
   void end_step(bool converged);

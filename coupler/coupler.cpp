@@ -2,11 +2,12 @@
 // one step is the list of named steps in step(); the coupled iterations that repeat some of them
 // live beside it.
 #include "coupler.hpp"
-#include "driver.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+
+#include "driver.hpp"
 
 namespace coupler {
 
@@ -30,7 +31,8 @@ void Coupler::run() {
   const auto& s = m_rt.settings();
   fsi::Progress::Options po;
   po.every_steps = s.progress_every;
-  m_progress = std::make_unique<fsi::Progress>("[coupler]", s.steps, fsi::step_time(s, s.steps), po);
+  m_progress =
+      std::make_unique<fsi::Progress>("[coupler]", s.steps, fsi::step_time(s, s.steps), po);
   m_t_start = m_rt.wall_seconds();
   for (long n = 0; n < s.steps; ++n) step(n);
   finish();
@@ -67,7 +69,8 @@ void Coupler::exchange(Role r, const In& in, Out& out, long n) {
 // fluid's own work ahead of its input.
 void Coupler::begin_step(long n) {
   const auto& s = m_rt.settings();
-  m_sb = proto::StepBegin{n, fsi::step_time(s, n), s.dt, proto::Action::step, 0, iterates() ? 1 : 0};
+  m_sb =
+      proto::StepBegin{n, fsi::step_time(s, n), s.dt, proto::Action::step, 0, iterates() ? 1 : 0};
   for (Role r : {Role::fluid, Role::fiber})
     if (has(r)) m_rt.link(r).send(m_sb, n);
   m_rt.check_fault(n);
@@ -79,7 +82,8 @@ void Coupler::begin_step(long n) {
   m_guess = m_start;
   if (m_v_before.size() == m_start.v.size())
     for (std::size_t b = 0; b < m_guess.v.size(); ++b)
-      if (m_meshes.bodies[b].kind == proto::BodyKind::elastic && m_v_before[b].size() == m_guess.v[b].size())
+      if (m_meshes.bodies[b].kind == proto::BodyKind::elastic &&
+          m_v_before[b].size() == m_guess.v[b].size())
         for (std::size_t d = 0; d < m_guess.v[b].size(); ++d)
           m_guess.v[b][d] = 2 * m_start.v[b][d] - m_v_before[b][d];
   m_v_before = m_start.v;
@@ -92,8 +96,10 @@ void Coupler::begin_step(long n) {
 void Coupler::footprint() {
   if (!m_immersed) return;
   m_phases.start("footprint");
-  if (m_sb.iteration == 0) m_immersed->update(footprint_state(), m_fluid_in.solid_u, m_fluid_in.solid_v);
-  else m_immersed->update_velocities(footprint_state(), m_fluid_in.solid_u, m_fluid_in.solid_v);
+  if (m_sb.iteration == 0)
+    m_immersed->update(footprint_state(), m_fluid_in.solid_u, m_fluid_in.solid_v);
+  else
+    m_immersed->update_velocities(footprint_state(), m_fluid_in.solid_u, m_fluid_in.solid_v);
   m_phases.stop("footprint");
 }
 
@@ -206,8 +212,9 @@ void Coupler::count_iterations(long n) {
                    "[coupler] WARNING: step %ld (t = %.6g): the coupled iterations did not "
                    "converge in coupler.iterations.max = %d: residual %.3e, tolerance %.1e%s\n",
                    n, m_sb.time, m_iter.max, m_res, m_iter.tolerance,
-                   m_not_converged == kWarnedSteps ? " (further warnings only counted in summary.json)"
-                                                   : "");
+                   m_not_converged == kWarnedSteps
+                       ? " (further warnings only counted in summary.json)"
+                       : "");
   }
   m_iter_csv->write(fsi::step_time(m_rt.settings(), n + 1),
                     {double(n), double(m_its), m_res_first, m_res, m_converged ? 1.0 : 0.0,
@@ -261,7 +268,8 @@ void Coupler::report(long n) {
 void Coupler::gather_velocities(const proto::SolidState& s, std::vector<double>& x) const {
   x.clear();
   for (std::size_t b = 0; b < m_meshes.bodies.size(); ++b)
-    if (m_meshes.bodies[b].kind == proto::BodyKind::elastic) x.insert(x.end(), s.v[b].begin(), s.v[b].end());
+    if (m_meshes.bodies[b].kind == proto::BodyKind::elastic)
+      x.insert(x.end(), s.v[b].begin(), s.v[b].end());
 }
 
 void Coupler::scatter_velocities(const std::vector<double>& x, proto::SolidState& s) const {

@@ -117,10 +117,10 @@ class Coupler {
   std::map<std::string, std::string> m_effective;  // role -> its effective scene (TOML)
   std::unique_ptr<ImmersedSolid> m_immersed;
   std::unique_ptr<FeedbackIB> m_ib;
-  double m_kappa = 0;          // feedback stiffness (force per length per length), coupler.kappa
-  double m_kappa_gain = 0.5;   // the default rule's one-step gain, see default_kappa()
+  double m_kappa = 0;         // feedback stiffness (force per length per length), coupler.kappa
+  double m_kappa_gain = 0.5;  // the default rule's one-step gain, see default_kappa()
   bool m_kappa_given = false;
-  bool m_have_samples = false; // fluid velocity samples around the markers are stored
+  bool m_have_samples = false;  // fluid velocity samples around the markers are stored
   std::vector<Root> m_roots;
   std::vector<double> m_u_markers;  // scratch: U(X^n) of one fiber
   std::vector<ForceGroup> m_force_groups;

@@ -44,7 +44,8 @@ void Coupler::feedback_forces() {
     F.assign(X.size(), 0.0);
     if (!m_have_samples) continue;
     m_ib->interpolate(X, m_u_markers);
-    for (std::size_t m = 0; m < X.size(); ++m) F[m] = m_kappa * (dt * m_u_markers[m] - (X[m] - Xo[m]));
+    for (std::size_t m = 0; m < X.size(); ++m)
+      F[m] = m_kappa * (dt * m_u_markers[m] - (X[m] - Xo[m]));
     m_ib->spread(X, F, m_layout.fibers[k].ds);
   }
   m_ib->take_spread(m_fluid_in.force_u, m_fluid_in.force_v);

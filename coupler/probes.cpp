@@ -34,7 +34,8 @@ void Coupler::setup_force_probes() {
     for (const auto& b : bodies) m_force_groups.push_back({b.name, {b.name}, {}});
   for (std::size_t g = 0; g < m_force_groups.size(); ++g) {
     for (const auto& name : m_force_groups[g].body_names) {
-      auto it = std::find_if(bodies.begin(), bodies.end(), [&](const auto& b) { return b.name == name; });
+      auto it =
+          std::find_if(bodies.begin(), bodies.end(), [&](const auto& b) { return b.name == name; });
       if (it == bodies.end())
         throw fsi::InputError(fmt::format(
             "coupler.force[{}].bodies names body '{}', which the scene does not have (bodies: {}) "
@@ -45,7 +46,8 @@ void Coupler::setup_force_probes() {
   }
   if (!m_force_groups.empty()) {
     std::vector<std::string> cols;
-    for (const auto& g : m_force_groups) cols.push_back(g.name + ".fx"), cols.push_back(g.name + ".fy");
+    for (const auto& g : m_force_groups)
+      cols.push_back(g.name + ".fx"), cols.push_back(g.name + ".fy");
     m_probes = std::make_unique<fsi::ProbeCsv>(m_rt.out_dir() / "coupler_forces.csv", cols);
     m_probe_row.assign(cols.size(), 0.0);
   }

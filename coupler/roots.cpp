@@ -21,7 +21,8 @@ void Coupler::resolve_roots() {
   for (std::size_t k = 0; k < m_layout.fibers.size(); ++k) {
     const auto& f = m_layout.fibers[k];
     if (f.root != 1) continue;
-    auto it = std::find_if(bodies.begin(), bodies.end(), [&](const auto& b) { return b.name == f.body; });
+    auto it =
+        std::find_if(bodies.begin(), bodies.end(), [&](const auto& b) { return b.name == f.body; });
     if (it == bodies.end())
       throw fsi::InputError(fmt::format(
           "fiber '{}' is rooted on body '{}', which the scene does not have (bodies: {}) (in {})",
@@ -58,7 +59,8 @@ void Coupler::root_poses(const proto::SolidState& state,
     const Root& r = m_roots[k];
     if (r.body < 0) continue;
     const auto& x = state.x[r.body];
-    const double ax = x[2 * r.a], ay = x[2 * r.a + 1], dx = x[2 * r.b] - ax, dy = x[2 * r.b + 1] - ay;
+    const double ax = x[2 * r.a], ay = x[2 * r.a + 1], dx = x[2 * r.b] - ax,
+                 dy = x[2 * r.b + 1] - ay;
     const double len = std::hypot(dx, dy);
     poses[k] = {ax + r.s * dx, ay + r.s * dy, dy / len, -dx / len};
   }

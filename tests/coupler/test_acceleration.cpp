@@ -1,7 +1,6 @@
 // The coupler's acceleration of the coupled iterations (acceleration.hpp) on linear
 // fixed points x = J x + c with a known solution.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <random>
 
@@ -60,7 +59,8 @@ int solve(const Linear& H, Acceleration& a, std::vector<double>& x, int max, dou
   for (int k = 0; k < max; ++k) {
     const auto xt = H(x);
     double r = 0, v = 0;
-    for (std::size_t i = 0; i < x.size(); ++i) r += (xt[i] - x[i]) * (xt[i] - x[i]), v += xt[i] * xt[i];
+    for (std::size_t i = 0; i < x.size(); ++i)
+      r += (xt[i] - x[i]) * (xt[i] - x[i]), v += xt[i] * xt[i];
     if (std::sqrt(r) <= tol * std::sqrt(v)) {
       a.end_step(true);
       return k + 1;
@@ -74,7 +74,8 @@ int solve(const Linear& H, Acceleration& a, std::vector<double>& x, int max, dou
 
 double error(const Linear& H, const std::vector<double>& x) {
   double e = 0, s = 0;
-  for (int i = 0; i < H.n; ++i) e += std::pow(x[i] - H.solution[i], 2), s += std::pow(H.solution[i], 2);
+  for (int i = 0; i < H.n; ++i)
+    e += std::pow(x[i] - H.solution[i], 2), s += std::pow(H.solution[i], 2);
   return std::sqrt(e / s);
 }
 
@@ -87,7 +88,9 @@ Linear amplifying(unsigned seed) {
   return Linear(mu, seed);
 }
 
-TEST_CASE("IQN-ILS solves a strongly amplifying linear coupling in about as many iterations as it has amplified modes") {
+TEST_CASE(
+    "IQN-ILS solves a strongly amplifying linear coupling in about as many iterations as it has "
+    "amplified modes") {
   const Linear H = amplifying(7);
   IterationSettings s;
   Acceleration a(s);
