@@ -6,11 +6,11 @@
 
 #include <array>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include <memory>
-
+#include "acceleration.hpp"
 #include "exchange_log.hpp"
 #include "ib.hpp"
 #include "immersed.hpp"
@@ -24,85 +24,67 @@ namespace coupler {
 
 namespace proto = fsi::proto;
 
-// [coupler.iterations]: sub-iterations of the coupled step (README.md, "Coupled iterations").
-struct IterationSettings {
-  enum class Method { constant, aitken, iqn_ils };
-  int max = 1;              // sub-iterations per step; 1: the explicit staggered step
-  double tolerance = 1e-6;  // on ||v^(k+1) - v^(k)|| relative to ||v^(k+1)||
-  Method method = Method::iqn_ils;
-  double relaxation = 0.5;  // the first (constant, Aitken: initial) relaxation factor
-  int reuse = 0;            // IQN-ILS: previous steps whose secant pairs are kept
-};
-
-// The acceleration of the fixed point x = H(x) of one coupled step, x the stacked nodal
-// velocities of the elastic bodies at t^(n+1) and H one pass fluid forcing + projection ->
-// reaction -> solid step. Each update() takes the input x^k and its image x~^k = H(x^k) and
-// gives the next input x^(k+1). Methods (r^k = x~^k - x^k):
-//  constant: x^(k+1) = x^k + w r^k.
-//  aitken:   the same with w_k = -w_(k-1) r^(k-1).(r^k - r^(k-1)) / |r^k - r^(k-1)|^2 (Irons-Tuck;
-//            Kuettler & Wall 2008), |w_k| <= kAitkenMax; w_0 = relaxation every step.
-//  iqn_ils:  Degroote et al. 2009: with columns V_i = r^(i+1) - r^i, W_i = x~^(i+1) - x~^i
-//            (this step's, newest first, then those of `reuse` previous steps), c = argmin
-//            |V c + r^k| (Eigen Householder QR on the columns kept), x^(k+1) = x~^k + W c: the
-//            least-squares inverse Jacobian of the residual on the span of V. A column whose part
-//            orthogonal to the newer ones is below kFilter of its length is dropped. Without
-//            columns (k = 0 and nothing reused): constant relaxation.
-class Acceleration {
- public:
-  static constexpr double kAitkenMax = 2.0;
-  static constexpr double kFilter = 1e-3;
-  explicit Acceleration(const IterationSettings& s) : m_s(s) {}
-  void begin_step();
-  void update(const std::vector<double>& x, const std::vector<double>& xt, std::vector<double>& next);
-  // The step is over: a converged step's secant pairs join the kept ones (IQN-ILS, reuse); a
-  // step that did not converge clears them all.
-  void end_step(bool converged);
-  double omega() const { return m_omega; }
-  int columns() const { return m_columns; }  // columns used by the last IQN-ILS update
-
- private:
-  struct Pairs {  // secant pairs of one step, newest first
-    std::vector<std::vector<double>> v, w;
-  };
-  IterationSettings m_s;
-  int m_k = 0;
-  double m_omega = 0;
-  int m_columns = 0;
-  std::vector<double> m_r_prev, m_xt_prev;
-  Pairs m_now;
-  std::vector<Pairs> m_old;  // previous steps, newest first
-};
+// Larger than any length or distance of a scene: the start of a search for the smallest one.
+inline constexpr double kFar = 1e300;
 
 class Coupler {
  public:
+  // Reads the [coupler] table of the scene (setup.cpp).
   explicit Coupler(fsi::Runtime& rt);
   // Set-up exchange, every step of the scene, then the end of the run and summary.json.
   // Collective over the job.
   void run();
 
  private:
-  void setup();
+  // The clock and the step (coupler.cpp).
   void step(long n);
+  void begin_step(long n);
+  void footprint();
+  void begin_solid_step(long n);
+  void fluid(long n);
+  void reaction();
+  void solid(long n);
+  void iterate(long n);
+  double residual();
+  void next_estimate();
+  void count_iterations(long n);
+  void commit(long n);
+  void fibers(long n);
+  void report(long n);
   void finish();
   bool has(fsi::Role r) const { return m_rt.roles()[r]; }
+  bool iterates() const { return m_accel && m_immersed; }
+  // The state the footprint is taken from: x^n with v^n (explicit step) or with the current
+  // estimate of v^(n+1) (coupled iterations).
+  const proto::SolidState& footprint_state() const { return iterates() ? m_guess : m_start; }
+  void gather_velocities(const proto::SolidState& s, std::vector<double>& x) const;
+  void scatter_velocities(const std::vector<double>& x, proto::SolidState& s) const;
+  template <class In, class Out>
+  void exchange(fsi::Role r, const In& in, Out& out, long n);
+  // Set-up and input (setup.cpp).
+  void setup();
+  void read_iterations(const fsi::SceneTable& t);
+  void check_can_iterate() const;
+  void write_effective_scene() const;
+  std::string body_names() const;
+  // The fibers' feedback force (feedback.cpp).
+  void default_kappa();
+  void feedback_forces();
+  // Health checks (health.cpp).
   const char* outside(double x, double y) const;
   void check_bodies_in_domain(long step) const;
   void check_fibers_in_domain(long step) const;
   void check_growth(long step);
   void warn_element_sizes() const;
-  void write_force_probes(long step, const proto::SolidState& start,
-                          const std::vector<std::vector<double>>& reaction);
+  void warn_marker_spacing() const;
+  // Fiber roots on bodies (roots.cpp).
   void resolve_roots();
   void root_poses(const proto::SolidState& state, std::vector<std::vector<double>>& poses) const;
-  void feedback_forces();
   void add_root_loads(const proto::SolidState& state);
-  void read_iterations(const fsi::SceneTable& t);
-  void check_can_iterate() const;
-  void gather_velocities(const proto::SolidState& s, std::vector<double>& x) const;
-  void scatter_velocities(const std::vector<double>& x, proto::SolidState& s) const;
-  template <class In, class Out>
-  void exchange(fsi::Role r, const In& in, Out& out, long n);
-  std::string body_names() const;
+  // Force probes (probes.cpp).
+  void setup_force_probes();
+  void write_force_probes(long step, const proto::SolidState& start,
+                          const std::vector<std::vector<double>>& reaction);
 
   // Where an attached fiber's root sits: surface edge `edge` (node a -> node b) of body `body`, at
   // parameter s along it. body < 0: the fiber is not attached to a body.
@@ -125,6 +107,7 @@ class Coupler {
   proto::BodyMeshes m_meshes;
   proto::FiberLayout m_layout;
   // Latest states and the messages of a step (kept to reuse their storage).
+  proto::StepBegin m_sb;
   proto::SolidState m_solid;
   proto::FiberState m_fiber;
   proto::FluidInput m_fluid_in;
@@ -134,10 +117,10 @@ class Coupler {
   std::map<std::string, std::string> m_effective;  // role -> its effective scene (TOML)
   std::unique_ptr<ImmersedSolid> m_immersed;
   std::unique_ptr<FeedbackIB> m_ib;
-  double m_kappa = 0;          // feedback stiffness (force per length per length), coupler.kappa
-  double m_kappa_gain = 0.5;   // the default rule's one-step gain, see resolve_roots()
+  double m_kappa = 0;         // feedback stiffness (force per length per length), coupler.kappa
+  double m_kappa_gain = 0.5;  // the default rule's one-step gain, see default_kappa()
   bool m_kappa_given = false;
-  bool m_have_samples = false; // fluid velocity samples around the markers are stored
+  bool m_have_samples = false;  // fluid velocity samples around the markers are stored
   std::vector<Root> m_roots;
   std::vector<double> m_u_markers;  // scratch: U(X^n) of one fiber
   std::vector<ForceGroup> m_force_groups;
@@ -160,6 +143,7 @@ class Coupler {
   std::vector<long> m_growing;
   fsi::PhaseTimer m_phases;
   double m_t_start = 0;
+  double m_h_min = 0;  // smallest grid spacing (element sizes; the iterations' tolerance floor)
   // Coupled iterations: settings, the state of step n (and v^(n-1)), the state the footprint is
   // taken from (x^n with the current estimate of v^(n+1)), the stacked velocities of one
   // iteration (input, output, next input), the reaction of the last iteration, statistics.
@@ -168,7 +152,9 @@ class Coupler {
   proto::SolidState m_start, m_guess;
   std::vector<std::vector<double>> m_v_before, m_reaction;
   std::vector<double> m_x_in, m_x_out, m_x_next;
-  double m_h_min = 0;  // smallest grid spacing (the tolerance's floor, from the fluid's CFL)
+  long m_its = 1;  // this step: iterations, first and last residual, converged
+  double m_res_first = 0, m_res = 0;
+  bool m_converged = true;
   long m_iter_total = 0, m_iter_max = 0, m_not_converged = 0;
   double m_residual_max = 0;
   std::unique_ptr<fsi::ProbeCsv> m_iter_csv;

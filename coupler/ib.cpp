@@ -16,11 +16,15 @@ double peskin4(double r) {
 }
 
 namespace {
+// Spacings within this fraction of their mean count as equal: round-off of the face coordinates,
+// not a stretching.
+constexpr double kUniform = 1e-9;
+
 bool uniform(const std::vector<double>& f, double& h) {
   const int n = static_cast<int>(f.size()) - 1;
   h = (f[n] - f[0]) / n;
   for (int i = 0; i < n; ++i)
-    if (std::abs(f[i + 1] - f[i] - h) > 1e-9 * h) return false;
+    if (std::abs(f[i + 1] - f[i] - h) > kUniform * h) return false;
   return true;
 }
 }  // namespace

@@ -12,6 +12,10 @@ namespace coupler {
 
 namespace {
 
+// Edges whose spacings agree within this fraction of their mean are evenly spaced (round-off of
+// the coordinates, not a stretching): their index comes from one division.
+constexpr double kEven = 1e-9;
+
 // Box edges at the cell centres c(k−1), k = 0..n, of a direction with faces f[0..nc]: the
 // control volumes of the faces of that direction. Outside the grid, a periodic direction wraps;
 // a bounded one mirrors (those boxes belong to boundary faces, which never take part).
@@ -66,7 +70,7 @@ EdgeIndex::EdgeIndex(const std::vector<double>& e) : m_e(&e) {
   const double h = (e[n] - e[0]) / static_cast<double>(n);
   m_even = n > 0 && h > 0;
   for (std::size_t k = 1; k <= n && m_even; ++k)
-    m_even = std::abs(e[k] - e[k - 1] - h) <= 1e-9 * h;
+    m_even = std::abs(e[k] - e[k - 1] - h) <= kEven * h;
   if (m_even) m_inv = 1.0 / h;
 }
 

@@ -1,0 +1,174 @@
+// The coupler's set-up: its [coupler] table, the set-up messages (common/PROTOCOL.md, S1-S9),
+// the transfers' construction, the checks at t^0, and the effective scene.
+#include <algorithm>
+#include <sstream>
+#include <toml.hpp>
+
+#include "coupler.hpp"
+
+namespace coupler {
+
+using fsi::Role;
+
+namespace {
+
+// Upper bound of coupler.kappa_gain: the explicit spring between a marker and the fluid is stable
+// for a one-step gain g < 2 (feedback.cpp).
+constexpr double kMaxKappaGain = 2.0;
+// Caps of [coupler.iterations] max and reuse: far above what a converging scene needs, so a
+// larger value is a typing error rather than a setting.
+constexpr long kMaxIterations = 1000;
+constexpr long kMaxReuse = 100;
+
+}  // namespace
+
+Coupler::Coupler(fsi::Runtime& rt) : m_rt(rt) {
+  if (const auto c = rt.root().optional_table("coupler")) {
+    for (const auto& f : c->tables("force")) {
+      ForceGroup g;
+      g.name = f.string("name");
+      g.body_names = f.strings("bodies");
+      f.finish();
+      m_force_groups.push_back(g);
+    }
+    m_kappa_given = c->has("kappa");
+    if (m_kappa_given) m_kappa = c->positive("kappa");
+    m_kappa_gain = c->in_range("kappa_gain", 0.0, kMaxKappaGain, true, m_kappa_gain);
+    if (const auto d = c->optional_table("diagnostics")) {
+      m_log_csv = d->boolean("exchange", false);
+      m_dump_every = d->integer("dump_every", 0);
+      if (m_dump_every < 0)
+        d->fail("dump_every", fmt::format("must be >= 0 (0: no dump), got {}", m_dump_every));
+      d->finish();
+    }
+    if (const auto h = c->optional_table("health")) {
+      m_growth_factor = h->number("growth_factor", m_growth_factor);
+      if (!(m_growth_factor > 1))
+        h->fail("growth_factor", fmt::format("must be > 1, got {}", m_growth_factor));
+      m_growth_steps = h->positive_integer("growth_steps", m_growth_steps);
+      h->finish();
+    }
+    if (const auto it = c->optional_table("iterations")) read_iterations(*it);
+    c->finish();
+  }
+  if (m_iter.max > 1) m_accel = std::make_unique<Acceleration>(m_iter);
+}
+
+// [coupler.iterations]. `acceleration` names the one method there is, IQN-ILS: still accepted so
+// that scenes which name it keep running.
+void Coupler::read_iterations(const fsi::SceneTable& t) {
+  m_iter.max = static_cast<int>(t.positive_integer("max", 1));
+  if (m_iter.max > kMaxIterations)
+    t.fail("max", fmt::format("must be <= {}, got {}", kMaxIterations, m_iter.max));
+  m_iter.tolerance = t.in_range("tolerance", 0.0, 1.0, true, m_iter.tolerance);
+  t.choice("acceleration", {"iqn-ils"}, "iqn-ils");
+  m_iter.relaxation = t.in_range("relaxation", 0.0, 1.0, false, m_iter.relaxation);
+  if (!(m_iter.relaxation > 0)) t.fail("relaxation", "must be in (0, 1], got 0");
+  const long reuse = t.integer("reuse", 0);
+  if (reuse < 0 || reuse > kMaxReuse)
+    t.fail("reuse", fmt::format("must be in [0, {}], got {}", kMaxReuse, reuse));
+  m_iter.reuse = static_cast<int>(reuse);
+  t.finish();
+}
+
+// Sub-iterations need a fluid and a solid that can repeat a step (their ports say so at set-up).
+void Coupler::check_can_iterate() const {
+  if (m_iter.max <= 1) return;
+  auto refuse = [&](const char* program) {
+    throw fsi::InputError(fmt::format(
+        "coupler.iterations.max = {} asks every step to be repeated, but the {} program cannot "
+        "repeat a step (its port does not implement coupled iterations); set max = 1 (in {})",
+        m_iter.max, program, m_rt.scene().file().string()));
+  };
+  if (has(Role::fluid) && !m_grid.can_iterate) refuse("fluid");
+  if (has(Role::solid) && !m_meshes.can_iterate) refuse("solid");
+}
+
+// Set-up, once: grid from the fluid; meshes and initial state from the solid; layout from the
+// fiber, then the fibers' root poses at t^0 and their initial state; each solver's effective
+// scene. Then the transfers, the checks at t^0, the probes and logs.
+void Coupler::setup() {
+  auto effective = [&](fsi::Link& l, const char* role) {
+    proto::Text t{proto::Tag::effective_scene, {}};
+    l.recv(t);
+    m_effective[role] = t.text;
+  };
+  if (has(Role::fluid)) {
+    auto& l = m_rt.link(Role::fluid);
+    l.recv(m_grid);
+    effective(l, "fluid");
+  }
+  if (has(Role::solid)) {
+    auto& l = m_rt.link(Role::solid);
+    l.recv(m_meshes);
+    l.recv(m_solid);
+    effective(l, "solid");
+  }
+  if (has(Role::fiber)) {
+    auto& l = m_rt.link(Role::fiber);
+    l.recv(m_layout);
+    m_fiber_in.force.assign(m_layout.fibers.size(), {});
+    resolve_roots();
+    root_poses(m_solid, m_fiber_in.root_pose);
+    l.send(m_fiber_in);
+    l.recv(m_fiber);
+    effective(l, "fiber");
+  }
+
+  if (!m_layout.fibers.empty() && has(Role::fluid)) {
+    m_ib = std::make_unique<FeedbackIB>(m_grid);
+    if (!m_kappa_given) default_kappa();
+  }
+  check_can_iterate();
+  m_h_min = kFar;
+  for (std::size_t i = 0; i + 1 < m_grid.x_face.size(); ++i)
+    m_h_min = std::min(m_h_min, m_grid.x_face[i + 1] - m_grid.x_face[i]);
+  for (std::size_t j = 0; j + 1 < m_grid.y_face.size(); ++j)
+    m_h_min = std::min(m_h_min, m_grid.y_face[j + 1] - m_grid.y_face[j]);
+  const auto& bodies = m_meshes.bodies;
+  if (!bodies.empty()) {
+    if (!has(Role::fluid))
+      fsi::fail("the scene has solid bodies and fibers but no fluid: nothing couples them");
+    m_immersed = std::make_unique<ImmersedSolid>(m_grid, m_meshes);
+    check_bodies_in_domain(0);
+    warn_element_sizes();
+  }
+  m_solid_in.force.assign(bodies.size(), {});
+  if (m_ib) warn_marker_spacing();
+  setup_force_probes();
+  if (m_accel)
+    m_iter_csv = std::make_unique<fsi::ProbeCsv>(
+        m_rt.out_dir() / "coupler_iterations.csv",
+        std::vector<std::string>{"step", "iterations", "residual_first", "residual", "converged",
+                                 "omega", "columns"});
+  if (m_log_csv || m_dump_every > 0)
+    m_log = std::make_unique<ExchangeLog>(m_rt.out_dir(), m_grid, m_meshes, m_layout,
+                                          m_rt.settings().dt, m_log_csv, m_dump_every);
+  if (m_ib) check_fibers_in_domain(0);
+  m_energy.assign(bodies.size(), 0.0);
+  m_growing.assign(bodies.size(), 0);
+  m_velocity.assign(bodies.size(), {});
+  check_growth(0);
+  write_effective_scene();
+}
+
+// scene.effective.toml: the coupler's own reading, each solver's table from that solver.
+void Coupler::write_effective_scene() const {
+  std::istringstream own(m_rt.scene().effective_toml());
+  auto doc = toml::parse<toml::discard_comments, std::map, std::vector>(own, "effective");
+  for (const auto& [role, text] : m_effective) {
+    std::istringstream is(text);
+    const auto part = toml::parse<toml::discard_comments, std::map, std::vector>(is, role);
+    if (part.contains(role)) doc.as_table()[role] = part.at(role);
+  }
+  fsi::write_file_atomically(m_rt.out_dir() / "scene.effective.toml", toml::format(doc));
+}
+
+// "bar, cylinder", or "none": the bodies' names for error messages.
+std::string Coupler::body_names() const {
+  std::vector<std::string> names;
+  for (const auto& b : m_meshes.bodies) names.push_back(b.name);
+  return names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", "));
+}
+
+}  // namespace coupler
