@@ -41,7 +41,6 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
   double scale2 = 0, floor2 = 0;
   double* values = m_matrix.valuePtr();
   const bool dynamic = c0 > 0;
-  const bool lumped = m_model.settings.lumped_mass;
   for (auto& bp : m_bodies) {
     Body& B = *bp;
     if (!B.is_elastic()) continue;
@@ -51,7 +50,7 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
     if (external && static_cast<int>(external->size()) > B.index && !(*external)[B.index].empty()) {
       const auto& fe = (*external)[B.index];
       if (fe.size() != B.f_ext.size())
-        fsi::fail("solid: external forces for body '{}' have {} values, expected {}", B.spec.name,
+        fsi::fail("external forces for body '{}' have {} values, expected {}", B.spec.name,
                   fe.size(), B.f_ext.size());
       for (std::size_t d = 0; d < fe.size(); ++d) B.f_cpl[d] = fe[d];
     } else {
@@ -64,7 +63,7 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
         !(*m_iteration_velocity)[B.index].empty()) {
       iter_w = &(*m_iteration_velocity)[B.index];
       if (iter_w->size() != B.u.size())
-        fsi::fail("solid: iteration velocities for body '{}' have {} values, expected {}",
+        fsi::fail("iteration velocities for body '{}' have {} values, expected {}",
                   B.spec.name, iter_w->size(), B.u.size());
     }
     std::vector<double>& r = B.r;
@@ -101,7 +100,7 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
       // term; each removes scale(k) * (M vec)_k from the residual and adds scale(k) * (M |vec|)_k
       // to its round-off floor, k = 2a + i.
       double me[3][3] = {};
-      if (dynamic && (B.rho_inertia[e] > 0 || iter_w)) element_mass(B.geo[e].area, lumped, me);
+      if (dynamic && (B.rho_inertia[e] > 0 || iter_w)) element_mass(B.geo[e].area, me);
       auto mass_terms = [&](const double* vec, const double* vec_abs, auto scale) {
         for (int a = 0; a < 3; ++a)
           for (int i = 0; i < 2; ++i) {

@@ -264,11 +264,9 @@ Config read_config(const fsi::SceneTable& s, double fluid_density) {
   st.analysis = analysis == "static" ? Analysis::statics : Analysis::dynamic;
   st.fluid_density = fluid_density;
   st.gravity = s.vec2("gravity", {0, 0});
-  st.lumped_mass = s.choice("mass", {"consistent", "lumped"}, "consistent") == "lumped";
   st.newton_tolerance = s.positive("newton_tolerance", 1e-10);
   st.newton_max_iterations = static_cast<int>(s.positive_integer("newton_max_iterations", 30));
   st.contact_tolerance = s.positive("contact_tolerance", 1e-10);
-  st.iteration_fluid_mass = s.boolean("iteration_fluid_mass", true);
   c.modes = static_cast<int>(s.integer("modes", 0));
   if (c.modes < 0) s.fail("modes", fmt::format("must be >= 0, got {}", c.modes));
   c.initial_mode = static_cast<int>(s.integer("initial_mode", 0));

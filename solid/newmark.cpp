@@ -37,7 +37,7 @@ void Solver::factorize_ahead(double dt) {
 // R(x^(n+1)) + B^T lambda = 0 with the contact conditions, then the trapezoidal update.
 StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* external,
                            const std::vector<std::vector<double>>* iteration_velocity) {
-  if (!(dt > 0)) fsi::fail("solid: time step must be > 0, got {}", dt);
+  if (!(dt > 0)) fsi::fail("time step must be > 0, got {}", dt);
   if (m_bodies.empty()) {  // a scene without bodies: only the clock moves
     m_time += dt;
     m_step++;
@@ -46,16 +46,15 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
     return none;
   }
   if (m_model.settings.analysis != Analysis::dynamic)
-    fsi::fail("solid: advance() needs a dynamic analysis");
+    fsi::fail("advance() needs a dynamic analysis");
   const double t1 = m_time + dt;
   const std::string when = fmt::format("step {} (t = {:.6g})", m_step + 1, t1);
   if (m_step == 0 && m_time == 0) initial_acceleration(dt);
   predict(t1);
   m_contact_force_factor = kNewmarkContactForceFactor;
-  m_iteration_velocity =
-      m_model.settings.iteration_fluid_mass && m_model.settings.fluid_density > 0
-          ? iteration_velocity
-          : nullptr;
+  // Coupled iterations: the fluid's reaction is linearised about the coupler's velocity
+  // (assembly.cpp); without a fluid there is no reaction to linearise.
+  m_iteration_velocity = m_model.settings.fluid_density > 0 ? iteration_velocity : nullptr;
   StepReport rep;
   try {
     rep = newton(newmark_c0(dt), dt, t1, external, when);

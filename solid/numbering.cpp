@@ -25,7 +25,7 @@ void Solver::number_equations() {
       const auto& con = B.spec.constraints[c];
       if (!mesh.has_boundary(con.boundary))
         throw fsi::InputError(
-            fmt::format("solid: body '{}': constraint boundary '{}' is not in mesh {} (it has: {})",
+            fmt::format("body '{}': constraint boundary '{}' is not in mesh {} (it has: {})",
                         name, con.boundary, mesh.source, fmt::join(mesh.boundary_names(), ", ")));
       const auto nodes = mesh.boundary_nodes(con.boundary);
       if (con.type != Constraint::Type::periodic) {
@@ -37,7 +37,7 @@ void Solver::number_equations() {
       }
       if (!mesh.has_boundary(con.partner))
         throw fsi::InputError(
-            fmt::format("solid: body '{}': periodic partner '{}' is not in mesh {} (it has: {})",
+            fmt::format("body '{}': periodic partner '{}' is not in mesh {} (it has: {})",
                         name, con.partner, mesh.source, fmt::join(mesh.boundary_names(), ", ")));
       const auto partners = mesh.boundary_nodes(con.partner);
       Vec2 shift = con.shift;
@@ -58,7 +58,7 @@ void Solver::number_equations() {
             match = p;
         if (match < 0)
           throw fsi::InputError(fmt::format(
-              "solid: body '{}': periodic boundary '{}' node {} at ({}, {}) has no partner on '{}' "
+              "body '{}': periodic boundary '{}' node {} at ({}, {}) has no partner on '{}' "
               "(shift ({}, {}))",
               name, con.boundary, n, mesh.x[2 * n], mesh.x[2 * n + 1], con.partner, shift[0],
               shift[1]));
@@ -74,7 +74,7 @@ void Solver::number_equations() {
       while (by[r] < 0 && master[r] >= 0 && guard++ < ndof) r = master[r];
       if (guard >= ndof)
         throw fsi::InputError(
-            fmt::format("solid: body '{}': periodic constraints form a loop", name));
+            fmt::format("body '{}': periodic constraints form a loop", name));
       root[d] = r;
     }
     B.prescribed.clear();
@@ -105,7 +105,7 @@ void Solver::number_equations() {
       for (const auto& p : B.prescribed) (p.component == 0 ? px : py)++;
       if (px == 0 || py == 0 || px + py < 3)
         throw fsi::InputError(fmt::format(
-            "solid: body '{}' has no constraint that holds it in {} ({} x and {} y components "
+            "body '{}' has no constraint that holds it in {} ({} x and {} y components "
             "prescribed): a static solve is singular; fix or prescribe a boundary",
             name, px == 0 && py == 0 ? "place" : (px == 0 ? "x" : (py == 0 ? "y" : "rotation")), px,
             py));
@@ -115,7 +115,7 @@ void Solver::number_equations() {
     for (const auto& b : m_bodies)
       if (b->is_elastic())
         throw fsi::InputError(
-            fmt::format("solid: body '{}' has every node prescribed", b->spec.name));
+            fmt::format("body '{}' has every node prescribed", b->spec.name));
 }
 
 int Solver::matrix_index(int row, int col) const {
@@ -187,7 +187,7 @@ bool Solver::factorize_cached() {
 void Solver::factorize(const std::string& when) {
   if (!factorize_cached())
     fsi::fail(
-        "solid: the stiffness matrix is singular at {}: a body is not held against rigid "
+        "the stiffness matrix is singular at {}: a body is not held against rigid "
         "motion (no constraint, no mass, no contact) or an element has collapsed",
         when);
 }

@@ -12,14 +12,13 @@ namespace solid {
 
 double Solver::kinetic_energy() const {
   double k = 0;
-  const bool lumped = m_model.settings.lumped_mass;
   for (const auto& bp : m_bodies) {
     const Body& B = *bp;
     if (!B.is_elastic()) continue;
     for (int e = 0; e < B.spec.mesh.num_triangles(); ++e) {
       const auto& t = B.spec.mesh.triangles[e];
       double me[3][3];
-      element_mass(B.geo[e].area, lumped, me);
+      element_mass(B.geo[e].area, me);
       for (int a = 0; a < 3; ++a)
         for (int c = 0; c < 3; ++c)
           for (int i = 0; i < 2; ++i)
@@ -117,7 +116,7 @@ double Solver::min_contact_gap() const {
 Vec2 Solver::reaction(int b, const std::string& boundary) const {
   const Body& B = *m_bodies[b];
   if (!B.spec.mesh.has_boundary(boundary))
-    fsi::fail("solid: body '{}' has no boundary '{}'", B.spec.name, boundary);
+    fsi::fail("body '{}' has no boundary '{}'", B.spec.name, boundary);
   Vec2 f{0, 0};
   for (int n : B.spec.mesh.boundary_nodes(boundary))
     for (int i = 0; i < 2; ++i)

@@ -17,15 +17,15 @@ Solver::~Solver() = default;
 Solver::Solver(Model model, LinearSolver::Backend backend)
     : m_model(std::move(model)), m_linear(backend) {
   const auto& s = m_model.settings;
-  if (!(s.newton_tolerance > 0)) throw fsi::InputError("solid: newton tolerance must be > 0");
-  if (s.newton_max_iterations < 1) throw fsi::InputError("solid: newton iterations must be >= 1");
+  if (!(s.newton_tolerance > 0)) throw fsi::InputError("newton tolerance must be > 0");
+  if (s.newton_max_iterations < 1) throw fsi::InputError("newton iterations must be >= 1");
   if (s.analysis == Analysis::statics && s.load_steps < 1)
-    throw fsi::InputError("solid: load_steps must be >= 1");
+    throw fsi::InputError("load_steps must be >= 1");
   for (std::size_t b = 0; b < m_model.bodies.size(); ++b) {
     for (std::size_t c = 0; c < b; ++c)
       if (m_model.bodies[b].name == m_model.bodies[c].name)
         throw fsi::InputError(
-            fmt::format("solid: two bodies are named '{}'", m_model.bodies[b].name));
+            fmt::format("two bodies are named '{}'", m_model.bodies[b].name));
     m_bodies.push_back(std::make_unique<Body>());
     m_bodies.back()->spec = m_model.bodies[b];
     m_bodies.back()->index = static_cast<int>(b);
@@ -42,7 +42,7 @@ Solver::Solver(Model model, LinearSolver::Backend backend)
   for (const auto& p : m_model.contacts)
     if (p.slave < 0 || p.master < 0 || p.slave >= num_bodies() || p.master >= num_bodies() ||
         p.slave == p.master)
-      throw fsi::InputError("solid: a contact pair needs two different bodies");
+      throw fsi::InputError("a contact pair needs two different bodies");
   m_contact.setup(meshes, kinds, m_model.contacts, m_model.planes);
   update_rigid(0);
   update_prescribed(0);
@@ -82,14 +82,14 @@ void Solver::setup_body(int index) {
   if (!B.is_elastic()) return;
 
   if (B.spec.materials.size() != mesh.region_names.size())
-    throw fsi::InputError(fmt::format("solid: body '{}' has {} regions but {} materials", name,
+    throw fsi::InputError(fmt::format("body '{}' has {} regions but {} materials", name,
                                       mesh.region_names.size(), B.spec.materials.size()));
   for (std::size_t r = 0; r < B.spec.materials.size(); ++r) {
     const Material& m = B.spec.materials[r];
     if (!(m.mu > 0) || !(m.density > 0) ||
         (m.model == MaterialModel::neo_hookean ? !(m.bulk > 0) : !(m.lambda + m.mu > 0)))
       throw fsi::InputError(fmt::format(
-          "solid: body '{}' region '{}': material constants must be positive (mu {}, lambda {}, "
+          "body '{}' region '{}': material constants must be positive (mu {}, lambda {}, "
           "bulk {}, density {})",
           name, mesh.region_names[r], m.mu, m.lambda, m.bulk, m.density));
   }
@@ -104,13 +104,13 @@ void Solver::setup_body(int index) {
     const double rho = B.spec.materials[B.material[e]].density - st.fluid_density;
     if (rho < 0)
       throw fsi::InputError(fmt::format(
-          "solid: body '{}' region '{}': density {} is below the fluid density {} (a buoyant "
+          "body '{}' region '{}': density {} is below the fluid density {} (a buoyant "
           "solid needs a negative excess mass, which Newmark cannot integrate)",
           name, mesh.region_names[B.material[e]], B.spec.materials[B.material[e]].density,
           st.fluid_density));
     B.rho_inertia[e] = rho;
     double me[3][3];
-    element_mass(B.geo[e].area, st.lumped_mass, me);
+    element_mass(B.geo[e].area, me);
     for (int a = 0; a < 3; ++a)
       for (int c = 0; c < 3; ++c) {
         B.mass_row[2 * t[a]] += rho * me[a][c];
@@ -128,7 +128,7 @@ void Solver::setup_body(int index) {
       auto it = mesh.boundaries.find(load.boundary);
       if (it == mesh.boundaries.end())
         throw fsi::InputError(
-            fmt::format("solid: body '{}': load boundary '{}' is not an edge set "
+            fmt::format("body '{}': load boundary '{}' is not an edge set "
                         "of mesh {}",
                         name, load.boundary, mesh.source));
       for (const auto& e : it->second) {
@@ -170,7 +170,7 @@ void Solver::save_state(StepState& s) const {
 }
 
 void Solver::restore_state(const StepState& s) {
-  if (s.u.size() != m_bodies.size()) fsi::fail("solid: restore_state: a state of another model");
+  if (s.u.size() != m_bodies.size()) fsi::fail("restore_state: a state of another model");
   for (std::size_t b = 0; b < m_bodies.size(); ++b) {
     Body& B = *m_bodies[b];
     B.u = s.u[b], B.v = s.v[b], B.ma = s.ma[b], B.x = s.x[b], B.contact = s.contact[b];
@@ -202,7 +202,7 @@ std::vector<double> Solver::displacements(int b) const {
 void Solver::set_velocity(int b, const std::vector<double>& v) {
   Body& B = *m_bodies[b];
   if (v.size() != B.v.size())
-    fsi::fail("solid: set_velocity: wrong size for body '{}'", B.spec.name);
+    fsi::fail("set_velocity: wrong size for body '{}'", B.spec.name);
   for (std::size_t d = 0; d < v.size(); ++d)
     if (B.eq[d] >= 0) B.v[d] = v[d];
 }
@@ -210,7 +210,7 @@ void Solver::set_velocity(int b, const std::vector<double>& v) {
 void Solver::set_positions(int b, const std::vector<double>& x) {
   Body& B = *m_bodies[b];
   if (x.size() != B.x.size())
-    fsi::fail("solid: set_positions: wrong size for body '{}'", B.spec.name);
+    fsi::fail("set_positions: wrong size for body '{}'", B.spec.name);
   for (std::size_t d = 0; d < x.size(); ++d)
     if (B.eq[d] >= 0) B.u[d] = x[d] - B.X[d];
   B.sync_positions();

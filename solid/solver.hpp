@@ -72,9 +72,9 @@ class Solver {
   // node, step and time.
   //
   // Coupled iterations: iteration_velocity[b] (may be null or empty per body) is the velocity
-  // w at t + dt whose footprint the fluid's forcing used for `external`. With
-  // settings.iteration_fluid_mass the step then linearises the reaction about it (solver.cpp,
-  // assemble): a term that vanishes when the step returns v^(n+1) = w.
+  // w at t + dt whose footprint the fluid's forcing used for `external`. When the scene has a
+  // fluid (settings.fluid_density > 0) the step linearises the reaction about it (assembly.cpp):
+  // a term that vanishes when the step returns v^(n+1) = w.
   StepReport advance(double dt, const std::vector<std::vector<double>>* external = nullptr,
                      const std::vector<std::vector<double>>* iteration_velocity = nullptr);
   // Look-ahead: the first Newton matrix of the next dynamic step of size dt (at the current

@@ -19,7 +19,7 @@ StepReport Solver::solve_static_step(double factor) {
 
 std::vector<StepReport> Solver::solve_static() {
   if (m_model.settings.analysis != Analysis::statics)
-    fsi::fail("solid: solve_static() needs a static analysis");
+    fsi::fail("solve_static() needs a static analysis");
   std::vector<StepReport> reps;
   const int n = m_model.settings.load_steps;
   for (int k = 1; k <= n; ++k) {
