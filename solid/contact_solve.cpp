@@ -14,8 +14,8 @@ namespace solid {
 namespace {
 
 // Regularisation of the Schur complement, relative to its largest diagonal entry: makes the
-// repeated constraint of a two-way pair (two slots on one contact) harmless without moving
-// the multipliers measurably.
+// repeated constraint of a two-way pair (two slots on one contact, a singular S) solvable, a
+// perturbation near the round-off of S itself.
 constexpr double kSchurRegularisation = 1e-12;
 // A multiplier this small is zero: the absolute bound is next to the smallest normal double (an
 // underflowed step), the relative one is round-off of the value z it was stepping towards.

@@ -15,6 +15,13 @@ namespace solid {
 
 namespace {
 
+// Spectra's Lanczos: iteration cap, relative tolerance of the eigenvalues (near round-off, the
+// modes are validated against beam theory to many digits), and the extra Krylov vectors beyond
+// the 2 nev + 1 it needs at least (more converge the lowest modes in fewer restarts).
+constexpr int kLanczosMaxIterations = 1000;
+constexpr double kLanczosTolerance = 1e-12;
+constexpr int kLanczosExtraVectors = 20;
+
 // y = (K - sigma M)^-1 x through one sparse factorisation (lower triangles stored).
 class ShiftInvertOp {
  public:
@@ -77,14 +84,14 @@ Modes Solver::modes(int count, double shift) const {
   }
   const int n = m_neq;
   const int nev = std::min(count, n - 1);
-  const int ncv = std::min(n, std::max(2 * nev + 1, nev + 20));
+  const int ncv = std::min(n, std::max(2 * nev + 1, nev + kLanczosExtraVectors));
   ShiftInvertOp op(K, M);
   Spectra::SparseSymMatProd<double, Eigen::Lower> bop(M);
   Spectra::SymGEigsShiftSolver<ShiftInvertOp, Spectra::SparseSymMatProd<double, Eigen::Lower>,
                                Spectra::GEigsMode::ShiftInvert>
       solver(op, bop, nev, ncv, shift);
   solver.init();
-  solver.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
+  solver.compute(Spectra::SortRule::LargestMagn, kLanczosMaxIterations, kLanczosTolerance);
   if (solver.info() != Spectra::CompInfo::Successful)
     fsi::fail("modes: the eigensolver did not converge for {} modes", nev);
   const Eigen::VectorXd lam = solver.eigenvalues();

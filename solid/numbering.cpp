@@ -11,6 +11,15 @@
 
 namespace solid {
 
+namespace {
+
+// A periodic node and its partner's shifted image are one point when closer than this fraction
+// of the body's smallest surface edge: far below any edge, far above the round-off of a mesher's
+// coordinates.
+constexpr double kPeriodicMatch = 1e-6;
+
+}  // namespace
+
 void Solver::number_equations() {
   m_neq = 0;
   for (auto& bp : m_bodies) {
@@ -49,7 +58,7 @@ void Solver::number_equations() {
           for (int i = 0; i < 2; ++i) cb[i] += mesh.x[2 * n + i] / partners.size();
         shift = {ca[0] - cb[0], ca[1] - cb[1]};
       }
-      const double tol = 1e-6 * B.min_edge;
+      const double tol = kPeriodicMatch * B.min_edge;
       for (int n : nodes) {
         int match = -1;
         for (int p : partners)
