@@ -15,6 +15,10 @@ class SceneTable;
 
 namespace solid {
 
+// A probe point counts as inside its body when it lies within this barycentric tolerance outside
+// an element: a point given on the boundary (to the digits of a scene file) is accepted.
+constexpr double kProbeLocateTolerance = 1e-6;
+
 // A material point followed over time: its body and reference position.
 struct ProbeSpec {
   std::string name;

@@ -7,6 +7,17 @@
 
 namespace solid {
 
+namespace {
+
+// Two squared distances within this relative tolerance are a tie (a vertex shared by two edges):
+// the edge whose interior holds the projection wins, so the normal is the segment's.
+constexpr double kClosestTie = 1e-12;
+// A point farther than this from a vertex (relative to the edge length) takes the vertex's
+// direction as its normal; nearer, the vertex's direction is round-off and the edge's is used.
+constexpr double kVertexDistance = 1e-9;
+
+}  // namespace
+
 bool inside_surface(const Mesh& mesh, const std::vector<double>& x, double px, double py) {
   // Crossings of the ray from p towards +x with every surface edge (half-open in y).
   bool inside = false;
@@ -138,7 +149,7 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
     const double d2 = qx * qx + qy * qy;
     // Ties (a vertex shared by two edges) prefer the edge whose interior holds the projection.
     const bool interior = xi > 0 && xi < 1;
-    if (d2 < best * (1 - 1e-12) || (d2 <= best * (1 + 1e-12) && interior)) {
+    if (d2 < best * (1 - kClosestTie) || (d2 <= best * (1 + kClosestTie) && interior)) {
       best = d2;
       best_edge = static_cast<int>(k);
       best_xi = xi;
@@ -150,7 +161,7 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
   const double le = std::hypot(ex, ey);
   const double dist = std::sqrt(best);
   const bool vertex = best_xi <= 0 || best_xi >= 1;
-  if (vertex && dist > 1e-9 * le) {
+  if (vertex && dist > kVertexDistance * le) {
     const int v = best_xi <= 0 ? e[0] : e[1];
     const double sign = inside_surface(mesh, xm, px, py) ? -1.0 : 1.0;
     s.m0 = v;

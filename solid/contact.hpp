@@ -3,7 +3,7 @@
 // plane. The signed gap g = (x_s - x_p) . n, with x_p the closest point of the master surface and
 // n its outward normal, is negative inside the master (inside is decided by ray casting, so deep
 // penetration is caught too). Active constraints g = 0 are enforced by Lagrange multipliers
-// lambda >= 0 (solver.cpp); this file only does the geometry.
+// lambda >= 0 (contact_solve.cpp); this file only does the geometry.
 #pragma once
 
 #include <array>

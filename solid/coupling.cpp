@@ -37,12 +37,12 @@ BodyGeometry CouplingHook::geometry(int body) const {
 }
 
 SurfacePoint CouplingHook::surface_point(int body, int edge, double s) const {
-  if (body < 0 || body >= num_bodies()) fsi::fail("solid: surface point: no body {}", body);
+  if (body < 0 || body >= num_bodies()) fsi::fail("surface point: no body {}", body);
   const Mesh& m = m_solver.mesh(body);
   if (edge < 0 || edge >= static_cast<int>(m.surface.size()))
-    fsi::fail("solid: surface point: body '{}' has {} surface edges, asked for edge {}",
+    fsi::fail("surface point: body '{}' has {} surface edges, asked for edge {}",
               m_solver.model().bodies[body].name, m.surface.size(), edge);
-  if (!(s >= 0 && s <= 1)) fsi::fail("solid: surface point: parameter {} is outside [0, 1]", s);
+  if (!(s >= 0 && s <= 1)) fsi::fail("surface point: parameter {} is outside [0, 1]", s);
   const auto& e = m.surface[edge];
   const auto& x = m_solver.positions(body);
   const double ax = x[2 * e[0]], ay = x[2 * e[0] + 1];
@@ -61,7 +61,7 @@ void CouplingHook::add_point_load(int body, int edge, double s, const Vec2& forc
   const auto& x = m_solver.positions(body);
   if (nodal.empty()) nodal.assign(x.size(), 0.0);
   if (nodal.size() != x.size())
-    fsi::fail("solid: point load: nodal force vector has {} values, expected {}", nodal.size(),
+    fsi::fail("point load: nodal force vector has {} values, expected {}", nodal.size(),
               x.size());
   const int a = p.nodes[0], b = p.nodes[1];
   const auto f =

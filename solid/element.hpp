@@ -88,12 +88,11 @@ inline double element_internal(const Material& m, const ElementGeometry& g, cons
   return g.area * W;
 }
 
-// Mass of one element per unit inertial density and per direction (3x3, same for x and y):
-// consistent A0/12 [2 1 1; 1 2 1; 1 1 2], or lumped A0/3 I.
-inline void element_mass(double area, bool lumped, double me[3][3]) {
+// Consistent mass of one element per unit inertial density and per direction (3x3, same for x
+// and y): A0/12 [2 1 1; 1 2 1; 1 1 2].
+inline void element_mass(double area, double me[3][3]) {
   for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b)
-      me[a][b] = lumped ? (a == b ? area / 3 : 0.0) : area / 12 * (a == b ? 2.0 : 1.0);
+    for (int b = 0; b < 3; ++b) me[a][b] = area / 12 * (a == b ? 2.0 : 1.0);
 }
 
 }  // namespace solid

@@ -8,6 +8,14 @@
 
 namespace solid {
 
+namespace {
+
+// An LDL^T pivot below this fraction of the largest is a zero pivot: the matrix is singular
+// (a rigid motion without support), not merely ill-conditioned by a stiffness contrast.
+constexpr double kSingularPivot = 1e-13;
+
+}  // namespace
+
 struct LinearSolver::Impl {
   Backend requested = Backend::automatic;
   bool use_cholmod = false;  // last factorisation
@@ -63,7 +71,7 @@ bool LinearSolver::factorize(const Eigen::SparseMatrix<double>& lower) {
   m->ldlt.factorize(lower);
   if (m->ldlt.info() != Eigen::Success) return false;
   const Eigen::VectorXd D = m->ldlt.vectorD().cwiseAbs();
-  return D.size() == 0 || D.minCoeff() > 1e-13 * D.maxCoeff();
+  return D.size() == 0 || D.minCoeff() > kSingularPivot * D.maxCoeff();
 }
 
 Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& b) const {

@@ -1,10 +1,9 @@
 // The sparse direct solver of the Newton iterations: one symbolic analysis for the fixed
 // pattern, a numeric factorisation per iteration. Eigen's simplicial LDL^T (AMD ordering) by
 // default; CHOLMOD's supernodal Cholesky on request when the build has it (FSI_SOLID_CHOLMOD),
-// falling back to LDL^T for a matrix that is not positive definite. With Debian's reference
-// BLAS the supernodal factorisation measured 3-7x slower than LDL^T on the Turek-Hron bar
-// (bench_solid --backend cholmod), hence the default. Matrices are given by their lower
-// triangle.
+// falling back to LDL^T for a matrix that is not positive definite. LDL^T is the default as the
+// faster of the two on the meshes of this project (solid/README.md, Performance). Matrices are
+// given by their lower triangle.
 #pragma once
 
 #include <Eigen/Core>

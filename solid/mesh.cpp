@@ -12,6 +12,14 @@
 
 namespace solid {
 
+namespace {
+
+// An element whose area is below this fraction of its longest edge squared is degenerate
+// (collinear nodes to round-off): its gradients would be meaningless.
+constexpr double kDegenerateArea = 1e-12;
+
+}  // namespace
+
 bool Mesh::has_boundary(const std::string& name) const {
   return boundaries.count(name) > 0 || node_sets.count(name) > 0;
 }
@@ -97,7 +105,7 @@ MeshQuality finalize_mesh(Mesh& mesh, const std::vector<int>& orientation_group)
                  l2 = edge2(mesh, t[2], t[0]);
     const double lmax = std::max({l0, l1, l2});
     const double a = std::abs(signed_area(mesh, t));
-    if (!(a > 1e-12 * lmax))
+    if (!(a > kDegenerateArea * lmax))
       throw fsi::InputError(fmt::format(
           "mesh {}: element {} (nodes {}, {}, {}) is degenerate (area {:.3g}, longest edge {:.3g})",
           mesh.source, e, t[0], t[1], t[2], a, std::sqrt(lmax)));

@@ -96,13 +96,9 @@ struct Settings {
   int load_steps = 1;        // static analysis
   double fluid_density = 0;  // rho_f: inertia and gravity use rho_s - rho_f
   Vec2 gravity{0, 0};
-  bool lumped_mass = false;
   double newton_tolerance = 1e-10;  // on ||R|| relative to the force scale
   int newton_max_iterations = 30;
   double contact_tolerance = 1e-10;  // on the gap, relative to the smallest element edge
-  // Coupled iterations: linearise the fluid's reaction about the velocity the coupler used,
-  // dF/dv = -M_f/dt (solver.cpp, assemble). Vanishes at convergence.
-  bool iteration_fluid_mass = true;
 };
 
 struct Model {

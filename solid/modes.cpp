@@ -15,6 +15,13 @@ namespace solid {
 
 namespace {
 
+// Spectra's Lanczos: iteration cap, relative tolerance of the eigenvalues (near round-off, the
+// modes are validated against beam theory to many digits), and the extra Krylov vectors beyond
+// the 2 nev + 1 it needs at least (more converge the lowest modes in fewer restarts).
+constexpr int kLanczosMaxIterations = 1000;
+constexpr double kLanczosTolerance = 1e-12;
+constexpr int kLanczosExtraVectors = 20;
+
 // y = (K - sigma M)^-1 x through one sparse factorisation (lower triangles stored).
 class ShiftInvertOp {
  public:
@@ -28,7 +35,7 @@ class ShiftInvertOp {
     m_solver.analyze(A);
     if (!m_solver.factorize(A))
       fsi::fail(
-          "solid: modes: K - sigma M is singular for sigma = {} (a body without constraint "
+          "modes: K - sigma M is singular for sigma = {} (a body without constraint "
           "has zero-frequency modes; give a negative shift)",
           sigma);
   }
@@ -47,11 +54,10 @@ class ShiftInvertOp {
 }  // namespace
 
 Modes Solver::modes(int count, double shift) const {
-  if (count < 1) fsi::fail("solid: modes: need at least one mode, got {}", count);
+  if (count < 1) fsi::fail("modes: need at least one mode, got {}", count);
   Eigen::SparseMatrix<double> K = m_matrix, M = m_matrix;
   std::fill_n(K.valuePtr(), K.nonZeros(), 0.0);
   std::fill_n(M.valuePtr(), M.nonZeros(), 0.0);
-  const bool lumped = m_model.settings.lumped_mass;
   for (const auto& bp : m_bodies) {
     const Body& B = *bp;
     if (!B.is_elastic()) continue;
@@ -59,13 +65,13 @@ Modes Solver::modes(int count, double shift) const {
     for (int e = 0; e < B.spec.mesh.num_triangles(); ++e) {
       if (!(B.rho_inertia[e] > 0))
         fsi::fail(
-            "solid: modes need a positive inertial density rho_s - rho_f; body '{}' element "
+            "modes need a positive inertial density rho_s - rho_f; body '{}' element "
             "{} has {}",
             B.spec.name, e, B.rho_inertia[e]);
       double fe[6], ke[36], J;
       element_internal(B.spec.materials[B.material[e]], B.geo[e], zero, zero, zero, fe, ke, &J);
       double me[3][3];
-      element_mass(B.geo[e].area, lumped, me);
+      element_mass(B.geo[e].area, me);
       const auto& map = B.kmap[e];
       for (int r = 0; r < 6; ++r)
         for (int c = 0; c < 6; ++c) {
@@ -78,16 +84,16 @@ Modes Solver::modes(int count, double shift) const {
   }
   const int n = m_neq;
   const int nev = std::min(count, n - 1);
-  const int ncv = std::min(n, std::max(2 * nev + 1, nev + 20));
+  const int ncv = std::min(n, std::max(2 * nev + 1, nev + kLanczosExtraVectors));
   ShiftInvertOp op(K, M);
   Spectra::SparseSymMatProd<double, Eigen::Lower> bop(M);
   Spectra::SymGEigsShiftSolver<ShiftInvertOp, Spectra::SparseSymMatProd<double, Eigen::Lower>,
                                Spectra::GEigsMode::ShiftInvert>
       solver(op, bop, nev, ncv, shift);
   solver.init();
-  solver.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
+  solver.compute(Spectra::SortRule::LargestMagn, kLanczosMaxIterations, kLanczosTolerance);
   if (solver.info() != Spectra::CompInfo::Successful)
-    fsi::fail("solid: modes: the eigensolver did not converge for {} modes", nev);
+    fsi::fail("modes: the eigensolver did not converge for {} modes", nev);
   const Eigen::VectorXd lam = solver.eigenvalues();
   const Eigen::MatrixXd vec = solver.eigenvectors();
   std::vector<int> order(lam.size());

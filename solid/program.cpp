@@ -72,7 +72,7 @@ SolidProgram::SolidProgram(fsi::Runtime& rt)
     std::vector<std::string> names;
     for (const auto& p : m_cfg.probes) {
       names.push_back(p.name);
-      m_probe_points.push_back(locate(s.mesh(p.body), p.point[0], p.point[1], 1e-6));
+      m_probe_points.push_back(locate(s.mesh(p.body), p.point[0], p.point[1], kProbeLocateTolerance));
     }
     m_probes.emplace(rt.out_dir() / "solid_probes.csv",
                      fsi::probe_columns(names, {"x", "y", "ux", "uy", "vx", "vy"}));

@@ -72,9 +72,9 @@ class Solver {
   // node, step and time.
   //
   // Coupled iterations: iteration_velocity[b] (may be null or empty per body) is the velocity
-  // w at t + dt whose footprint the fluid's forcing used for `external`. With
-  // settings.iteration_fluid_mass the step then linearises the reaction about it (solver.cpp,
-  // assemble): a term that vanishes when the step returns v^(n+1) = w.
+  // w at t + dt whose footprint the fluid's forcing used for `external`. When the scene has a
+  // fluid (settings.fluid_density > 0) the step linearises the reaction about it (assembly.cpp):
+  // a term that vanishes when the step returns v^(n+1) = w.
   StepReport advance(double dt, const std::vector<std::vector<double>>* external = nullptr,
                      const std::vector<std::vector<double>>* iteration_velocity = nullptr);
   // Look-ahead: the first Newton matrix of the next dynamic step of size dt (at the current
@@ -154,10 +154,30 @@ class Solver {
   // Returns the first inverted element as (body, element) or (-1, -1).
   std::pair<int, int> assemble(double c0, double dt, bool with_matrix, double load_factor,
                                const std::vector<std::vector<double>>* external);
+  // Newton on the step's residual with contact (newton.cpp) and its parts.
   StepReport newton(double c0, double dt, double load_factor,
                     const std::vector<std::vector<double>>* external, const std::string& when);
+  void assemble_iterate(double c0, double dt, double time_or_factor,
+                        const std::vector<std::vector<double>>* external, bool have_step,
+                        Eigen::VectorXd& dx, const std::string& when);
+  bool is_converged(int it, double rn, double previous, double tolerance, double worst_gap,
+                    double gap_tol) const;
+  void apply_newton_step(const Eigen::VectorXd& dx);
+  // The contact solve of a Newton iteration (contact_solve.cpp).
+  struct ContactLinearisation;
+  double contact_gap_tolerance() const;
+  ContactLinearisation linearise_contact(double c0, double dt, double time_or_factor,
+                                         const std::vector<std::vector<double>>* external);
+  void add_contact_curvature(double c0, double dt, double time_or_factor,
+                             const std::vector<std::vector<double>>* external);
+  void solve_contact(const ContactLinearisation& con, double gap_tol, Eigen::VectorXd& dx);
+  void store_contact_forces();
   void factorize(const std::string& when);
   bool factorize_cached();
+  // The Newmark step's parts (newmark.cpp).
+  void initial_acceleration(double dt);
+  void predict(double t1);
+  void update_velocity(double dt);
   // u_old, v_old := u, v: the state the coming step starts from.
   void keep_step_start();
   // The Newmark (trapezoidal) inertia factor of the effective matrix, c0 = 4 / dt^2: one
@@ -167,6 +187,9 @@ class Solver {
                                 const std::string& when) const;
   void check_finite(const std::string& when) const;
   void check_inverted(const std::string& when) const;
+  [[noreturn]] void fail_non_finite_residual(std::pair<int, int> inverted,
+                                             const std::string& when) const;
+  [[noreturn]] void fail_not_converged(const StepReport& rep, const std::string& when) const;
 
   Model m_model;
   std::vector<std::unique_ptr<Body>> m_bodies;

@@ -1,5 +1,5 @@
 // Internal: the per-body data of the Solver (equation map, element data, state vectors),
-// shared by the solver's translation units (solver.cpp, modes.cpp). Not part of the API.
+// shared by the solver's translation units (solid/*.cpp of the Solver). Not part of the API.
 #pragma once
 
 #include <array>
@@ -47,6 +47,18 @@ struct Solver::Body {
   void sync_positions() {
     for (std::size_t d = 0; d < x.size(); ++d) x[d] = X[d] + u[d];
   }
+};
+
+// The contact terms of one Newton iteration (contact_solve.cpp): the candidate slots, each with
+// its row of B = dg/dx on the free equations and the gap shift B_p du_p of a pending prescribed
+// increment; the largest violation (penetration or open active gap); the residual R + B^T lambda.
+struct Solver::ContactLinearisation {
+  std::vector<int> candidates;                             // slot indices
+  std::vector<std::vector<std::pair<int, double>>> rows;  // per candidate: (equation, dg/dx)
+  std::vector<double> gap_shift;                           // per candidate
+  double worst_gap = 0;
+  int active = 0;  // active slots
+  Eigen::VectorXd residual;
 };
 
 }  // namespace solid

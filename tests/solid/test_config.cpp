@@ -216,6 +216,11 @@ TEST_CASE("unknown keys and wrong choices", "[config][input]") {
       read("probe.toml",
            "[solid]\n" + block + "[[solid.body.probe]]\nname = \"P\"\npoint = [3, 3]\n"),
       Catch::Contains("solid.body[0].probe[0].point") && Catch::Contains("outside body"));
+  // Options that served a study and were removed: a scene that still sets them is told so.
+  CHECK_THROWS_WITH(read("lumped.toml", "[solid]\nmass = \"lumped\"\n" + block),
+                    Catch::Contains("unknown key") && Catch::Contains("mass"));
+  CHECK_THROWS_WITH(read("fluid_mass.toml", "[solid]\niteration_fluid_mass = false\n" + block),
+                    Catch::Contains("unknown key") && Catch::Contains("iteration_fluid_mass"));
   const Config light = read("buoyant.toml", "[solid]\n" + block, 20.0);
   CHECK_THROWS_WITH(Solver(light.model), Catch::Contains("below the fluid density"));
 }

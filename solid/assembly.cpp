@@ -1,0 +1,206 @@
+// Assembly: the scene's loads, the internal force and its consistent tangent (material and
+// geometric stiffness of every element, element.hpp), the Newmark inertia, the coupling force and
+// the coupled iterations' linearised fluid reaction, into the residual on the free equations and
+// the effective matrix in its fixed pattern.
+#include <algorithm>
+#include <cmath>
+
+#include "error.hpp"
+#include "solver_body.hpp"
+
+namespace solid {
+
+std::vector<double> Solver::scene_loads(int b, double t) const {
+  std::vector<double> f(m_bodies[b]->X.size(), 0.0);
+  add_scene_loads(*m_bodies[b], t, f);
+  return f;
+}
+
+// F(t) = (gravity + sum_k f_k(t) load_k), or factor * (gravity + sum_k load_k) in statics.
+void Solver::add_scene_loads(const Body& B, double t, std::vector<double>& f) const {
+  if (!B.is_elastic()) return;
+  const bool statics = m_model.settings.analysis == Analysis::statics;
+  const double scale = statics ? t : 1.0;
+  for (std::size_t d = 0; d < f.size(); ++d) f[d] += scale * B.gravity[d];
+  for (std::size_t k = 0; k < B.load_dofs.size(); ++k) {
+    const double s = statics ? t : B.spec.loads[k].time(t);
+    for (const auto& [dof, c] : B.load_dofs[k]) f[dof] += s * c;
+  }
+}
+
+// Residual on the free equations, for Newmark (c0 = 4 / dt^2) or statics (c0 = 0):
+//   R = F(t) - Q(x) - c0 M (x - x^n - dt v^n) + (M a)^n,
+// with Q_a = sum_e A0 F S dN_a/dX (element.hpp) and, when with_matrix,
+//   K_eff = dQ/dx + c0 M  (material + geometric stiffness plus the Newmark mass term).
+// `time_or_factor` is t^(n+1) in dynamics and the load factor in statics.
+std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, double time_or_factor,
+                                     const std::vector<std::vector<double>>* external) {
+  std::pair<int, int> inverted{-1, -1};
+  if (with_matrix) std::fill_n(m_matrix.valuePtr(), m_matrix.nonZeros(), 0.0);
+  m_residual.setZero();
+  double scale2 = 0, floor2 = 0;
+  double* values = m_matrix.valuePtr();
+  const bool dynamic = c0 > 0;
+  for (auto& bp : m_bodies) {
+    Body& B = *bp;
+    if (!B.is_elastic()) continue;
+    const Mesh& mesh = B.spec.mesh;
+    std::fill(B.f_ext.begin(), B.f_ext.end(), 0.0);
+    add_scene_loads(B, time_or_factor, B.f_ext);
+    if (external && static_cast<int>(external->size()) > B.index && !(*external)[B.index].empty()) {
+      const auto& fe = (*external)[B.index];
+      if (fe.size() != B.f_ext.size())
+        fsi::fail("external forces for body '{}' have {} values, expected {}", B.spec.name,
+                  fe.size(), B.f_ext.size());
+      for (std::size_t d = 0; d < fe.size(); ++d) B.f_cpl[d] = fe[d];
+    } else {
+      std::fill(B.f_cpl.begin(), B.f_cpl.end(), 0.0);
+    }
+    std::fill(B.q.begin(), B.q.end(), 0.0);
+    const std::vector<double>* iter_w = nullptr;
+    if (dynamic && m_iteration_velocity &&
+        static_cast<int>(m_iteration_velocity->size()) > B.index &&
+        !(*m_iteration_velocity)[B.index].empty()) {
+      iter_w = &(*m_iteration_velocity)[B.index];
+      if (iter_w->size() != B.u.size())
+        fsi::fail("iteration velocities for body '{}' have {} values, expected {}",
+                  B.spec.name, iter_w->size(), B.u.size());
+    }
+    std::vector<double>& r = B.r;
+    // The coupling force is the reaction of the fluid's velocity correction over this step: an
+    // impulse F_c dt within the step, like the contact acceleration of the paper's Eq. 13-14
+    // (x^(n+1) = ... + dt^2/2 a_c, v^(n+1) = ... + dt a_c). In the trapezoidal residual
+    // (4/dt^2) M (x^(n+1) - x^n - dt v^n) - M a^n = F^(n+1) - Q^(n+1) + 2 F_c it enters twice,
+    // and it stays out of the stored M a (the next step does not average it in again): the
+    // solid receives the whole impulse in the step the fluid lost it, so momentum balances step
+    // by step. Averaging it over two steps delays the reaction and pumps energy into the solid's
+    // element-scale modes. Massless dofs (rho_s = rho_f) are quasi-static: F - Q + F_c = 0.
+    for (std::size_t d = 0; d < r.size(); ++d)
+      r[d] = B.f_ext[d] +
+             (dynamic ? B.ma[d] + (B.mass_row[d] > 0 ? 2.0 : 1.0) * B.f_cpl[d] : B.f_cpl[d]);
+    std::vector<double>& absq = B.abs_q;  // |element forces| and |K| |u|: scales of R
+    std::vector<double>& absm = B.abs_floor;
+    std::fill(absq.begin(), absq.end(), 0.0);
+    std::fill(absm.begin(), absm.end(), 0.0);
+    for (int e = 0; e < mesh.num_triangles(); ++e) {
+      const auto& t = mesh.triangles[e];
+      double fe[6], ke[36];
+      double J = 1;
+      element_internal(B.spec.materials[B.material[e]], B.geo[e], &B.u[2 * t[0]], &B.u[2 * t[1]],
+                       &B.u[2 * t[2]], fe, with_matrix ? ke : nullptr, &J);
+      B.det_f[e] = J;
+      if (!(J > 0) && inverted.first < 0) inverted = {B.index, e};
+      for (int a = 0; a < 3; ++a)
+        for (int i = 0; i < 2; ++i) {
+          const int d = 2 * t[a] + i;
+          B.q[d] += fe[2 * a + i];
+          absq[d] += std::abs(fe[2 * a + i]);
+        }
+      // The element's mass matrix (unit density), for the inertia and the coupled iterations'
+      // term; each removes scale(k) * (M vec)_k from the residual and adds scale(k) * (M |vec|)_k
+      // to its round-off floor, k = 2a + i.
+      double me[3][3] = {};
+      if (dynamic && (B.rho_inertia[e] > 0 || iter_w)) element_mass(B.geo[e].area, me);
+      auto mass_terms = [&](const double* vec, const double* vec_abs, auto scale) {
+        for (int a = 0; a < 3; ++a)
+          for (int i = 0; i < 2; ++i) {
+            double m = 0, mabs = 0;
+            for (int c = 0; c < 3; ++c) {
+              m += me[a][c] * vec[2 * c + i];
+              mabs += me[a][c] * vec_abs[2 * c + i];
+            }
+            r[2 * t[a] + i] -= scale(2 * a + i) * m;
+            absm[2 * t[a] + i] += scale(2 * a + i) * mabs;
+          }
+      };
+      if (dynamic && B.rho_inertia[e] > 0) {
+        const double rho = B.rho_inertia[e];
+        double w[6], wabs[6];
+        for (int a = 0; a < 3; ++a)
+          for (int i = 0; i < 2; ++i) {
+            const int d = 2 * t[a] + i;
+            w[2 * a + i] = B.u[d] - B.u_old[d] - dt * B.v_old[d];
+            wabs[2 * a + i] = std::abs(B.u[d]) + std::abs(B.u_old[d]) + dt * std::abs(B.v_old[d]);
+          }
+        mass_terms(w, wabs, [&](int) { return c0 * rho; });
+        if (with_matrix)
+          for (int a = 0; a < 3; ++a)
+            for (int c = 0; c < 3; ++c)
+              for (int i = 0; i < 2; ++i) ke[6 * (2 * a + i) + 2 * c + i] += c0 * rho * me[a][c];
+      }
+      if (iter_w) {
+        // Coupled iterations: the reaction F_c the coupler sent was computed from the
+        // velocity w it gave the fluid; about w it is F_c(v) ~ F_c - M_f (v - w) / dt, M_f the
+        // mass matrix of density rho_f (the fluid inside the body, which the forcing makes
+        // follow v). In the residual F_c enters with the weight s_d (2 on dofs with mass, 1 on
+        // massless ones, as above) and v_c^(n+1) = s_c (x_c^(n+1) - x_c^n) / dt - [mass] v_c^n,
+        // so
+        //   r_d -= s_d / dt sum_c M_f,dc (v_c - w_c),   K_dc += s_d s_c / dt^2 M_f,dc.
+        // The term vanishes when the step returns v^(n+1) = w (a converged iteration), and it
+        // gives a body without excess mass (rho_s = rho_f) the inertia rho_f it otherwise lacks
+        // within the step: a free neutrally buoyant body has a regular matrix.
+        const double rf = m_model.settings.fluid_density;
+        double sw[6], dv[6], vabs[6];  // vabs: |v| + |w|, the scale of the terms that cancel
+        for (int c = 0; c < 6; ++c) {
+          const int d = 2 * t[c / 2] + c % 2;
+          const bool mass = B.mass_row[d] > 0;
+          sw[c] = mass ? 2.0 : 1.0;
+          const double v = sw[c] * (B.u[d] - B.u_old[d]) / dt - (mass ? B.v_old[d] : 0.0);
+          dv[c] = v - (*iter_w)[d];
+          vabs[c] = std::abs(v) + std::abs((*iter_w)[d]);
+        }
+        mass_terms(dv, vabs, [&](int k) { return sw[k] * rf / dt; });
+        if (with_matrix)
+          for (int a = 0; a < 3; ++a)
+            for (int c = 0; c < 3; ++c)
+              for (int i = 0; i < 2; ++i)
+                ke[6 * (2 * a + i) + 2 * c + i] +=
+                    sw[2 * a + i] * sw[2 * c + i] * rf / (dt * dt) * me[a][c];
+      }
+      if (with_matrix && m_dirichlet_pending) {
+        double dp[6];
+        bool moved = false;
+        for (int c = 0; c < 6; ++c) {
+          dp[c] = B.dirichlet_step[2 * t[c / 2] + c % 2];
+          moved = moved || dp[c] != 0;
+        }
+        if (moved)
+          for (int rr = 0; rr < 6; ++rr) {
+            double f = 0;
+            for (int c = 0; c < 6; ++c) f += ke[6 * rr + c] * dp[c];
+            r[2 * t[rr / 2] + rr % 2] -= f;
+          }
+      }
+      if (with_matrix) {
+        // Round-off floor of the residual: |K| |u| (a residual cannot be resolved below eps of
+        // the element forces that cancel in it).
+        for (int rr = 0; rr < 6; ++rr) {
+          double f = 0;
+          for (int c = 0; c < 6; ++c)
+            f += std::abs(ke[6 * rr + c]) * std::abs(B.u[2 * t[c / 2] + c % 2]);
+          absm[2 * t[rr / 2] + rr % 2] += f;
+        }
+        const auto& map = B.kmap[e];
+        for (int k = 0; k < 36; ++k)
+          if (map[k] >= 0) values[map[k]] += ke[k];
+      }
+    }
+    for (std::size_t d = 0; d < r.size(); ++d) {
+      r[d] -= B.q[d];
+      if (B.eq[d] >= 0) {
+        m_residual[B.eq[d]] += r[d];
+        // The coupling force counts as it enters r: twice with mass, once on a massless dof.
+        const double w_cpl = dynamic && B.mass_row[d] > 0 ? 2.0 : 1.0;
+        const double s = std::abs(B.f_ext[d]) + w_cpl * std::abs(B.f_cpl[d]) + absq[d] +
+                         (dynamic ? std::abs(B.ma[d]) : 0.0);
+        scale2 += s * s;
+        floor2 += (s + absm[d]) * (s + absm[d]);
+      }
+    }
+  }
+  m_force_scale = std::sqrt(scale2);
+  m_roundoff_scale = std::sqrt(floor2);
+  return inverted;
+}
+
+}  // namespace solid

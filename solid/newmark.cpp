@@ -1,0 +1,112 @@
+// The Newmark step (beta = 1/4, gamma = 1/2, the trapezoidal rule): the predictor, Newton on the
+// step's residual with contact (newton.cpp), the velocity and acceleration update; and the
+// look-ahead factorisation of the next step's first matrix.
+#include "error.hpp"
+#include "solver_body.hpp"
+
+namespace solid {
+
+namespace {
+
+// Physical contact force per multiplier in a Newmark step. The multiplier balances the
+// trapezoidal residual, in which a force acting over the step enters with weight 2 (as the
+// coupling force does, assembly.cpp): the force on the bodies is lambda / 2.
+constexpr double kNewmarkContactForceFactor = 0.5;
+
+}  // namespace
+
+void Solver::keep_step_start() {
+  for (auto& bp : m_bodies) {
+    bp->u_old = bp->u;
+    bp->v_old = bp->v;
+  }
+}
+
+void Solver::factorize_ahead(double dt) {
+  if (m_bodies.empty() || m_neq == 0 || m_model.settings.analysis != Analysis::dynamic) return;
+  // Active contact adds its curvature to iteration 0's matrix after assembly: no match to hope for.
+  for (const auto& s : m_contact.slots())
+    if (s.active) return;
+  keep_step_start();  // as advance() begins (the residual's inertia reads them)
+  assemble(newmark_c0(dt), dt, true, m_time + dt, nullptr);
+  if (m_residual.allFinite()) factorize_cached();
+}
+
+// One step t^n -> t^(n+1) = t^n + dt:
+//   R(x) = F(t^(n+1)) - Q(x) - (4/dt^2) M (x - x^n - dt v^n) + (M a)^n + 2 F_c,
+// R(x^(n+1)) + B^T lambda = 0 with the contact conditions, then the trapezoidal update.
+StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* external,
+                           const std::vector<std::vector<double>>* iteration_velocity) {
+  if (!(dt > 0)) fsi::fail("time step must be > 0, got {}", dt);
+  if (m_bodies.empty()) {  // a scene without bodies: only the clock moves
+    m_time += dt;
+    m_step++;
+    StepReport none;
+    none.converged = true;
+    return none;
+  }
+  if (m_model.settings.analysis != Analysis::dynamic)
+    fsi::fail("advance() needs a dynamic analysis");
+  const double t1 = m_time + dt;
+  const std::string when = fmt::format("step {} (t = {:.6g})", m_step + 1, t1);
+  if (m_step == 0 && m_time == 0) initial_acceleration(dt);
+  predict(t1);
+  m_contact_force_factor = kNewmarkContactForceFactor;
+  // Coupled iterations: the fluid's reaction is linearised about the coupler's velocity
+  // (assembly.cpp); without a fluid there is no reaction to linearise.
+  m_iteration_velocity = m_model.settings.fluid_density > 0 ? iteration_velocity : nullptr;
+  StepReport rep;
+  try {
+    rep = newton(newmark_c0(dt), dt, t1, external, when);
+  } catch (...) {
+    m_iteration_velocity = nullptr;
+    throw;
+  }
+  m_iteration_velocity = nullptr;
+  update_velocity(dt);
+  m_time = t1;
+  m_step++;
+  check_finite(when);
+  check_inverted(when);
+  return rep;
+}
+
+// (M a)^0 = F^0 - Q(x^0) on the dofs that carry mass: the initial state starts in dynamic
+// balance with the scene's loads.
+void Solver::initial_acceleration(double dt) {
+  assemble(0, dt, false, 0.0, nullptr);
+  for (auto& bp : m_bodies)
+    for (std::size_t d = 0; d < bp->ma.size(); ++d)
+      bp->ma[d] = bp->is_elastic() && bp->mass_row[d] > 0 && bp->eq[d] >= 0
+                      ? bp->f_ext[d] - bp->q[d]
+                      : 0.0;
+}
+
+// The predictor: Newton starts from x^n (kept as the step's start), the rigid bodies are moved to
+// t^(n+1), and the prescribed displacements at t^(n+1) wait as an increment for the first solve.
+void Solver::predict(double t1) {
+  keep_step_start();
+  update_rigid(t1);
+  prepare_prescribed(t1);
+}
+
+// Newmark velocity from the positions, v^(n+1) = 2 (x^(n+1) - x^n) / dt - v^n (the trapezoidal
+// rule), and (M a)^(n+1) = F - Q: the acceleration without the contact part (Eq. 13-16).
+// Massless dofs (rho_s = rho_f) are quasi-static: v = (x^(n+1) - x^n) / dt, (M a) = 0.
+void Solver::update_velocity(double dt) {
+  for (auto& bp : m_bodies) {
+    Body& B = *bp;
+    if (!B.is_elastic()) continue;
+    for (std::size_t d = 0; d < B.u.size(); ++d) {
+      if (B.mass_row[d] > 0) {
+        B.v[d] = 2 * (B.u[d] - B.u_old[d]) / dt - B.v_old[d];
+        B.ma[d] = B.eq[d] >= 0 ? B.f_ext[d] - B.q[d] : 0.0;
+      } else {
+        B.v[d] = (B.u[d] - B.u_old[d]) / dt;
+        B.ma[d] = 0;
+      }
+    }
+  }
+}
+
+}  // namespace solid

@@ -1,0 +1,128 @@
+// Newton-Raphson for one Newmark step or one static load step, with the contact conditions
+// linearised in every iteration (contact_solve.cpp): assemble the residual and tangent at the
+// iterate, add the contact terms, test convergence, factorise and solve, update the iterate.
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "error.hpp"
+#include "solver_body.hpp"
+
+namespace solid {
+
+namespace {
+
+// Halvings of a Newton step whose iterate leaves the material's domain (neo-Hookean J <= 0):
+// 2^-12 of the step is well inside the last valid iterate's neighbourhood; beyond that the
+// step is hopeless and the run stops.
+constexpr int kMaxStepHalvings = 12;
+// A residual that fell by less than this factor in one iteration no longer converges
+// quadratically: it has reached its floor.
+constexpr double kStallRatio = 0.5;
+// The round-off floor of the residual relative to the terms that cancel in it (|F| + |Q| +
+// |inertia| + |K| |u|): some thousand machine epsilons, the rounding a sum of many such terms
+// accumulates.
+constexpr double kRoundoffFloor = 1e-12;
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+// Newton-Raphson on R(x) + B^T lambda = 0 with the contact conditions g(x) >= 0, lambda >= 0,
+// lambda g = 0 (paper Eq. 3-5). Each iteration linearises both:
+//   K_eff dx = R + B^T lambda,  g + B dx >= 0,  lambda >= 0,  lambda (g + B dx) = 0,
+// solved through the factorised K_eff: y0 = K^-1 R, Y = K^-1 B^T, the complementarity problem
+// for lambda with S = B Y, q = g + B y0 (solve_contact), then dx = y0 + Y lambda. The active
+// set is the lambda > 0 of the last iteration. Converged when ||R + B^T lambda|| <= tol, no slot
+// penetrates and every active gap is closed, both within the contact tolerance.
+StepReport Solver::newton(double c0, double dt, double time_or_factor,
+                          const std::vector<std::vector<double>>* external,
+                          const std::string& when) {
+  using clock = std::chrono::steady_clock;
+  const auto& st = m_model.settings;
+  StepReport rep;
+  const double gap_tol = contact_gap_tolerance();
+  Eigen::VectorXd dx(m_neq);
+  double previous = std::numeric_limits<double>::infinity();
+
+  for (int it = 0;; ++it) {
+    auto t0 = clock::now();
+    assemble_iterate(c0, dt, time_or_factor, external, it > 0, dx, when);
+    rep.assembly_seconds += seconds_since(t0);
+    const ContactLinearisation contact = linearise_contact(c0, dt, time_or_factor, external);
+
+    const double rn = contact.residual.norm();
+    rep.residuals.push_back(rn);
+    rep.tolerance = st.newton_tolerance * m_force_scale;
+    rep.active_contacts = contact.active;
+    if (is_converged(it, rn, previous, rep.tolerance, contact.worst_gap, gap_tol)) {
+      rep.converged = true;
+      break;
+    }
+    if (it >= st.newton_max_iterations) break;
+    previous = rn;
+
+    t0 = clock::now();
+    factorize(when);
+    rep.factor_seconds += seconds_since(t0);
+    t0 = clock::now();
+    dx = m_linear.solve(m_residual);
+    if (!contact.candidates.empty()) solve_contact(contact, gap_tol, dx);
+    rep.solve_seconds += seconds_since(t0);
+    apply_newton_step(dx);
+    rep.iterations++;
+  }
+
+  store_contact_forces();
+  if (!rep.converged) fail_not_converged(rep, when);
+  return rep;
+}
+
+// The residual and tangent at the iterate. An iterate that leaves the material's domain
+// (neo-Hookean J <= 0, a non-finite residual) is pulled back by halving the last step dx:
+// x <- x - dx/2, x - 3 dx/4, ...; a residual still not finite stops the run.
+void Solver::assemble_iterate(double c0, double dt, double time_or_factor,
+                              const std::vector<std::vector<double>>* external, bool have_step,
+                              Eigen::VectorXd& dx, const std::string& when) {
+  auto inverted = assemble(c0, dt, true, time_or_factor, external);
+  for (int halving = 0; have_step && !m_residual.allFinite() && halving < kMaxStepHalvings;
+       ++halving) {
+    dx *= 0.5;
+    for (auto& bp : m_bodies) {
+      Body& B = *bp;
+      if (!B.is_elastic()) continue;
+      for (std::size_t d = 0; d < B.u.size(); ++d)
+        if (B.eq[d] >= 0) B.u[d] -= dx[B.eq[d]];
+      B.sync_positions();
+    }
+    inverted = assemble(c0, dt, true, time_or_factor, external);
+  }
+  if (!m_residual.allFinite()) fail_non_finite_residual(inverted, when);
+}
+
+// Converged: ||R + B^T lambda|| below the tolerance, or stalled at its round-off floor after at
+// least one solve; and no slot penetrates, every active gap is closed, no prescribed increment
+// is still pending.
+bool Solver::is_converged(int it, double rn, double previous, double tolerance, double worst_gap,
+                          double gap_tol) const {
+  const bool small = rn <= tolerance;
+  const bool stalled =
+      it > 0 && rn > kStallRatio * previous && rn <= kRoundoffFloor * m_roundoff_scale;
+  return (small || stalled) && worst_gap <= gap_tol && !m_dirichlet_pending;
+}
+
+// x <- x + dx on the free equations; a pending prescribed increment is applied with the first.
+void Solver::apply_newton_step(const Eigen::VectorXd& dx) {
+  if (m_dirichlet_pending) apply_prescribed_step();
+  for (auto& bp : m_bodies) {
+    Body& B = *bp;
+    if (!B.is_elastic()) continue;
+    for (std::size_t d = 0; d < B.u.size(); ++d)
+      if (B.eq[d] >= 0) B.u[d] += dx[B.eq[d]];
+    B.sync_positions();
+  }
+}
+
+}  // namespace solid
