@@ -11,6 +11,8 @@ PACKAGES=(g++ cmake make pkg-config libeigen3-dev libopenmpi-dev openmpi-bin lib
           libfftw3-dev catch2 libfmt-dev libtoml11-dev gmsh libgmsh-dev libspectra-dev
           nlohmann-json3-dev libsuitesparse-dev python3 python3-matplotlib python3-h5py
           python3-numpy)
+# What only the tests need: ParaView (the XDMF test) and a virtual display for it to draw on.
+TEST_PACKAGES=(python3-paraview xvfb xauth libgl1-mesa-dri libglx-mesa0)
 
 say() { printf '[fsi] %s\n' "$*" >&2; }
 die() { printf '[fsi] ERROR: %s\n' "$*" >&2; exit 1; }
@@ -38,8 +40,8 @@ TXT
 
 # Debian packages: install what is missing when root, otherwise say exactly what to install.
 deps() {
-  local missing=()
-  for p in "${PACKAGES[@]}"; do
+  local missing=() wanted=("${PACKAGES[@]}" "$@")
+  for p in "${wanted[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   [ ${#missing[@]} -eq 0 ] && return 0
@@ -65,7 +67,8 @@ build_flags() {
 
 build() {
   local kind=${1:-release}
-  deps
+  shift || true
+  deps "$@"
   if [ ! -f "$BUILD/CMakeCache.txt" ]; then
     say "configuring in $BUILD ($kind)"
     cmake -S "$ROOT" -B "$BUILD" $(build_flags "$kind") >/dev/null
@@ -151,7 +154,7 @@ test_suite() {
     # paths (unit and integration tests) unless CTest arguments say otherwise.
     [ $# -eq 0 ] && select=(-L "unit|integration")
   fi
-  build "$kind"
+  build "$kind" "${TEST_PACKAGES[@]}"
   cd "$BUILD"
   ctest --output-on-failure -j 2 --timeout 900 "${select[@]}" "$@"
 }

@@ -72,14 +72,22 @@ std::vector<int> polyline_segments(std::span<const std::size_t> nodes_per_line) 
   return segments;
 }
 
+std::vector<double> rectilinear_nodes(std::span<const double> x, std::span<const double> y) {
+  std::vector<double> nodes;
+  nodes.reserve(2 * x.size() * y.size());
+  for (double yj : y)
+    for (double xi : x) nodes.push_back(xi), nodes.push_back(yj);
+  return nodes;
+}
+
 XdmfWriter::XdmfWriter(std::filesystem::path xdmf, const std::filesystem::path& h5, Grid grid,
                        std::string name)
     : m_xdmf(std::move(xdmf)), m_grid(std::move(grid)), m_name(std::move(name)) {
   auto folder = std::filesystem::absolute(m_xdmf).lexically_normal().parent_path();
   m_h5_ref = std::filesystem::absolute(h5).lexically_normal().lexically_relative(folder).generic_string();
   if (m_h5_ref.empty()) m_h5_ref = std::filesystem::absolute(h5).generic_string();
-  if (const auto* r = std::get_if<XdmfRectilinear>(&m_grid); r && (r->nx < 2 || r->ny < 2))
-    fail("XDMF {}: a rectilinear grid needs at least 2 x 2 nodes, got {} x {}", m_xdmf.string(), r->nx, r->ny);
+  if (const auto* r = std::get_if<XdmfStructured>(&m_grid); r && (r->nx < 2 || r->ny < 2))
+    fail("XDMF {}: a structured grid needs at least 2 x 2 nodes, got {} x {}", m_xdmf.string(), r->nx, r->ny);
 }
 
 std::string XdmfWriter::data_item(std::string_view dataset, const std::vector<std::size_t>& dims,
@@ -98,14 +106,13 @@ void XdmfWriter::add_step(double time, const std::vector<XdmfAttribute>& attribu
   xml += fmt::format("{}  <Time Value=\"{}\"/>\n", in, time);
 
   std::vector<std::size_t> node_dims, cell_dims;
-  if (const auto* r = std::get_if<XdmfRectilinear>(&m_grid)) {
+  if (const auto* r = std::get_if<XdmfStructured>(&m_grid)) {
     if (!geometry.empty())
-      fail("XDMF {}: a rectilinear grid takes no per-step geometry ('{}')", m_xdmf.string(), geometry);
-    // Structured dimensions count nodes, slowest first; VXVY lists x then y.
-    xml += fmt::format("{}  <Topology TopologyType=\"2DRectMesh\" Dimensions=\"{} {}\"/>\n", in, r->ny, r->nx);
-    xml += fmt::format("{}  <Geometry GeometryType=\"VXVY\">\n", in);
-    xml += fmt::format("{}    {}\n", in, data_item(r->x, {r->nx}, false));
-    xml += fmt::format("{}    {}\n", in, data_item(r->y, {r->ny}, false));
+      fail("XDMF {}: a structured grid takes no per-step geometry ('{}')", m_xdmf.string(), geometry);
+    // Structured dimensions count nodes, slowest first.
+    xml += fmt::format("{}  <Topology TopologyType=\"2DSMesh\" Dimensions=\"{} {}\"/>\n", in, r->ny, r->nx);
+    xml += fmt::format("{}  <Geometry GeometryType=\"XY\">\n", in);
+    xml += fmt::format("{}    {}\n", in, data_item(r->nodes, {r->ny * r->nx, 2}, false));
     xml += fmt::format("{}  </Geometry>\n", in);
     node_dims = {r->ny, r->nx};
     cell_dims = {r->ny - 1, r->nx - 1};

@@ -1,13 +1,13 @@
 // XDMF side files: the light XML that lets ParaView open the heavy data of an .h5 file as a time
 // series. One XdmfWriter describes one temporal collection of one kind of grid (a 2D
-// rectilinear grid, a triangle mesh, or a set of polylines); after each appended step the whole
+// structured grid, a triangle mesh, or a set of polylines); after each appended step the whole
 // file is rewritten through a temporary and a rename, so it is valid at any moment of a run.
 // Datasets are referenced by the .h5 path relative to the .xdmf file's folder.
 //
 //   H5File h5(out / "fluid.h5", H5File::Mode::truncate);
-//   h5.write("/grid/xf", xf);  h5.write("/grid/yf", yf);             // nx + 1, ny + 1 faces
+//   h5.write("/grid/nodes", rectilinear_nodes(xf, yf), {(ny + 1) * (nx + 1), 2});  // the faces
 //   XdmfWriter xdmf(out / "fluid.xdmf", out / "fluid.h5",
-//                   XdmfRectilinear{"/grid/xf", nx + 1, "/grid/yf", ny + 1}, "fluid");
+//                   XdmfStructured{"/grid/nodes", nx + 1, ny + 1}, "fluid");
 //   // each output step:
 //   std::string g = h5_step_group(step);
 //   h5.write_window(g + "/p", p, {ny + 2 * ng, nx + 2 * ng}, {ng, ng}, {ny, nx});
@@ -26,14 +26,14 @@
 
 namespace fsi {
 
-// Where an attribute's values live: on the grid's nodes or on its cells (rectilinear cells are
-// the rectangles between neighbouring x and y coordinates; mesh cells are triangles; polyline
+// Where an attribute's values live: on the grid's nodes or on its cells (structured cells are
+// the quadrilaterals between neighbouring nodes; mesh cells are triangles; polyline
 // cells are segments).
 enum class XdmfCenter { node, cell };
 
 // One field of a step: `dataset` in the .h5 file (e.g. "/step_000012/p") of float64 values.
-// Shape: scalar {ny, nx} on rectilinear nodes, {ny-1, nx-1} on its cells, {n} on mesh or polyline
-// nodes/cells. A vector has 3 components and shape {n_points, 3} (n_points = ny*nx on rectilinear
+// Shape: scalar {ny, nx} on structured nodes, {ny-1, nx-1} on its cells, {n} on mesh or polyline
+// nodes/cells. A vector has 3 components and shape {n_points, 3} (n_points = ny*nx on structured
 // nodes ...): store (vx, vy, 0), because ParaView reads a 2-component "Vector" as if it had 3.
 struct XdmfAttribute {
   std::string name;
@@ -42,15 +42,20 @@ struct XdmfAttribute {
   std::size_t components = 1;
 };
 
-// A 2D rectilinear grid: node coordinates x (nx float64 values) and y (ny values). The caller
-// chooses what the nodes are: cell faces (then cell-centred attributes are cell averages) or
-// cell centres (then node-centred attributes are the values at the centres).
-struct XdmfRectilinear {
-  std::string x = {};
+// A 2D structured grid of nx x ny nodes: `nodes` is an {ny * nx, 2} float64 dataset of the node
+// positions, x fastest (rectilinear_nodes() for a rectilinear grid). The caller chooses what the
+// nodes are: cell faces (then cell-centred attributes are cell averages) or cell centres (then
+// node-centred attributes are the values at the centres). A rectilinear grid is written this way,
+// not as a 2DRectMesh with VXVY coordinates, because ParaView 5.11's three XDMF readers read such
+// coordinates as arrays of nx * ny values and draw the grid as a line.
+struct XdmfStructured {
+  std::string nodes = {};
   std::size_t nx = 0;
-  std::string y = {};
   std::size_t ny = 0;
 };
+
+// The {ny * nx, 2} node positions (x fastest) of the rectilinear grid with coordinates x and y.
+std::vector<double> rectilinear_nodes(std::span<const double> x, std::span<const double> y);
 
 // A triangle mesh: `topology` is an int32 dataset {n_triangles, 3} of 0-based node indices,
 // written once. Node positions are an {n_nodes, 2} float64 dataset, given per step or, for a
@@ -77,7 +82,7 @@ std::vector<int> polyline_segments(std::span<const std::size_t> nodes_per_line);
 
 class XdmfWriter {
  public:
-  using Grid = std::variant<XdmfRectilinear, XdmfTriangles, XdmfPolylines>;
+  using Grid = std::variant<XdmfStructured, XdmfTriangles, XdmfPolylines>;
 
   // `xdmf` is the side file to (re)write, `h5` the data file it points into, `name` the
   // collection's name in ParaView. Nothing is written before the first step.
@@ -85,7 +90,7 @@ class XdmfWriter {
              std::string name = "grid");
 
   // Appends one time step and rewrites the file. `geometry` is the step's {n_nodes, 2} node
-  // positions (meshes and polylines; empty = the fixed geometry; must be empty for rectilinear).
+  // positions (meshes and polylines; empty = the fixed geometry; must be empty for structured).
   void add_step(double time, const std::vector<XdmfAttribute>& attributes,
                 std::string_view geometry = {});
 

@@ -54,14 +54,12 @@ Coupler::Coupler(fsi::Runtime& rt) : m_rt(rt) {
   if (m_iter.max > 1) m_accel = std::make_unique<Acceleration>(m_iter);
 }
 
-// [coupler.iterations]. `acceleration` names the one method there is, IQN-ILS: still accepted so
-// that scenes which name it keep running.
+// [coupler.iterations] (IQN-ILS, acceleration.hpp).
 void Coupler::read_iterations(const fsi::SceneTable& t) {
   m_iter.max = static_cast<int>(t.positive_integer("max", 1));
   if (m_iter.max > kMaxIterations)
     t.fail("max", fmt::format("must be <= {}, got {}", kMaxIterations, m_iter.max));
   m_iter.tolerance = t.in_range("tolerance", 0.0, 1.0, true, m_iter.tolerance);
-  t.choice("acceleration", {"iqn-ils"}, "iqn-ils");
   m_iter.relaxation = t.in_range("relaxation", 0.0, 1.0, false, m_iter.relaxation);
   if (!(m_iter.relaxation > 0)) t.fail("relaxation", "must be in (0, 1], got 0");
   const long reuse = t.integer("reuse", 0);

@@ -24,6 +24,7 @@ FluidProgram::FluidProgram(fsi::Runtime& rt)
   m_h5.create_group("grid");
   m_h5.write("grid/x_face", xf);
   m_h5.write("grid/y_face", yf);
+  m_h5.write("grid/nodes", fsi::rectilinear_nodes(xf, yf), {yf.size() * xf.size(), 2});
   m_h5.set_attribute("grid", "density", m_cfg.density);
   m_h5.set_attribute("grid", "viscosity", m_cfg.viscosity);
   for (Side s : m_cfg.wall_shear) {
@@ -32,7 +33,7 @@ FluidProgram::FluidProgram(fsi::Runtime& rt)
     m_h5.write(fmt::format("grid/tau_{}_position", kSideNames[s]), pos);
   }
   m_xdmf.emplace(rt.out_dir() / "fluid.xdmf", rt.out_dir() / "fluid.h5",
-                 fsi::XdmfRectilinear{"/grid/x_face", xf.size(), "/grid/y_face", yf.size()},
+                 fsi::XdmfStructured{"/grid/nodes", xf.size(), yf.size()},
                  "fluid");
   if (!m_cfg.probes.empty()) {
     std::vector<std::string> names;

@@ -72,9 +72,9 @@ TEST_CASE("rectilinear grid: valid after every step, relative references", "[xdm
   fs::path dir = fresh_dir("rectilinear");
   const std::size_t nx = 5, ny = 4;
   H5File h5(dir / "fluid.h5", H5File::Mode::truncate);
-  h5.write("/grid/x", std::vector<double>{0, 0.25, 0.5, 0.75, 1.0});
-  h5.write("/grid/y", std::vector<double>{0, 0.1, 0.2, 0.3});
-  XdmfWriter xdmf(dir / "fluid.xdmf", dir / "fluid.h5", fsi::XdmfRectilinear{"/grid/x", nx, "/grid/y", ny}, "fluid");
+  const std::vector<double> x{0, 0.25, 0.5, 0.75, 1.0}, y{0, 0.1, 0.2, 0.3};
+  h5.write("/grid/nodes", fsi::rectilinear_nodes(x, y), {ny * nx, 2});
+  XdmfWriter xdmf(dir / "fluid.xdmf", dir / "fluid.h5", fsi::XdmfStructured{"/grid/nodes", nx, ny}, "fluid");
   CHECK_FALSE(fs::exists(dir / "fluid.xdmf"));
   for (long step = 0; step < 3; ++step) {
     write_fluid_step(h5, xdmf, step, nx, ny);
@@ -84,7 +84,8 @@ TEST_CASE("rectilinear grid: valid after every step, relative references", "[xdm
   }
   std::string text = read_text(dir / "fluid.xdmf");
   CHECK(text.find(">fluid.h5:/step_000002/p</DataItem>") != std::string::npos);
-  CHECK(text.find("TopologyType=\"2DRectMesh\" Dimensions=\"4 5\"") != std::string::npos);
+  CHECK(text.find("TopologyType=\"2DSMesh\" Dimensions=\"4 5\"") != std::string::npos);
+  CHECK(text.find("Dimensions=\"20 2\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">fluid.h5:/grid/nodes<") != std::string::npos);
   CHECK(text.find("Dimensions=\"3 4\"") != std::string::npos);   // cells
   CHECK(text.find("Dimensions=\"20 3\"") != std::string::npos);  // a vector per node
   CHECK(xdmf.steps() == 3);
@@ -93,13 +94,18 @@ TEST_CASE("rectilinear grid: valid after every step, relative references", "[xdm
   CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 2);
 }
 
+TEST_CASE("rectilinear_nodes: the node positions of a rectilinear grid, x fastest", "[xdmf]") {
+  const std::vector<double> x{0, 0.5, 2}, y{-1, 1};
+  CHECK(fsi::rectilinear_nodes(x, y) == std::vector<double>{0, -1, 0.5, -1, 2, -1, 0, 1, 0.5, 1, 2, 1});
+}
+
 TEST_CASE("the data file may sit in another folder", "[xdmf]") {
   fs::path dir = fresh_dir("subfolder");
   fs::create_directories(dir / "data");
   H5File h5(dir / "data" / "fluid.h5", H5File::Mode::truncate);
-  h5.write("x", std::vector<double>{0, 1});
-  h5.write("y", std::vector<double>{0, 1, 2});
-  XdmfWriter xdmf(dir / "fluid.xdmf", dir / "data" / "fluid.h5", fsi::XdmfRectilinear{"x", 2, "y", 3});
+  h5.write("nodes", fsi::rectilinear_nodes(std::vector<double>{0, 1}, std::vector<double>{0, 1, 2}),
+           {6, 2});
+  XdmfWriter xdmf(dir / "fluid.xdmf", dir / "data" / "fluid.h5", fsi::XdmfStructured{"nodes", 2, 3});
   h5.write("/step_000000/p", std::vector<double>{1, 2}, {2, 1});
   xdmf.add_step(0.0, {{"p", XdmfCenter::cell, "/step_000000/p"}});
   CHECK(read_text(dir / "fluid.xdmf").find(">data/fluid.h5:/step_000000/p<") != std::string::npos);
@@ -162,11 +168,11 @@ TEST_CASE("polylines: segment connectivity for lines of different lengths", "[xd
 TEST_CASE("xdmf_check reports missing datasets, wrong shapes and wrong types", "[xdmf]") {
   fs::path dir = fresh_dir("bad");
   H5File h5(dir / "f.h5", H5File::Mode::truncate);
-  h5.write("x", std::vector<double>{0, 1, 2});
-  h5.write("y", std::vector<double>{0, 1});
+  h5.write("nodes", fsi::rectilinear_nodes(std::vector<double>{0, 1, 2}, std::vector<double>{0, 1}),
+           {6, 2});
   h5.write("/s0/p", std::vector<double>{1, 2, 3}, {1, 3});  // node shape {2, 3} was meant
   h5.write("/s0/q", std::vector<int>{1, 2}, {1, 2});        // right shape, int instead of float64
-  XdmfWriter xdmf(dir / "f.xdmf", dir / "f.h5", fsi::XdmfRectilinear{"x", 3, "y", 2});
+  XdmfWriter xdmf(dir / "f.xdmf", dir / "f.h5", fsi::XdmfStructured{"nodes", 3, 2});
   xdmf.add_step(0.0, {{"p", XdmfCenter::node, "/s0/p"}, {"q", XdmfCenter::cell, "/s0/q"},
                       {"r", XdmfCenter::cell, "/s0/r"}});
   std::vector<std::string> problems = fsi::xdmf_check(dir / "f.xdmf");
@@ -176,7 +182,7 @@ TEST_CASE("xdmf_check reports missing datasets, wrong shapes and wrong types", "
   CHECK_THAT(problems[1], Catch::Contains("/s0/q") && Catch::Contains("int32"));
   CHECK_THAT(problems[2], Catch::Contains("/s0/r") && Catch::Contains("no such dataset"));
   CHECK(fsi::xdmf_check(dir / "none.xdmf").size() == 1);
-  CHECK_THROWS_AS(XdmfWriter(dir / "g.xdmf", dir / "f.h5", fsi::XdmfRectilinear{"x", 1, "y", 2}), fsi::Error);
+  CHECK_THROWS_AS(XdmfWriter(dir / "g.xdmf", dir / "f.h5", fsi::XdmfStructured{"nodes", 1, 2}), fsi::Error);
   CHECK_THROWS_AS(xdmf.add_step(1.0, {}, "/s0/p"), fsi::Error);  // rectilinear takes no geometry
   CHECK_THROWS_WITH(xdmf.add_step(1.0, {{"v", XdmfCenter::node, "/s0/v", 2}}), Catch::Contains("(vx, vy, 0)"));
   CHECK(xdmf.steps() == 1);
@@ -187,13 +193,13 @@ TEST_CASE("resume keeps the steps up to the restart time", "[xdmf]") {
   const std::size_t nx = 3, ny = 3;
   {
     H5File h5(dir / "fluid.h5", H5File::Mode::truncate);
-    h5.write("/grid/x", std::vector<double>{0, 1, 2});
-    h5.write("/grid/y", std::vector<double>{0, 1, 2});
-    XdmfWriter xdmf(dir / "fluid.xdmf", dir / "fluid.h5", fsi::XdmfRectilinear{"/grid/x", nx, "/grid/y", ny});
+    h5.write("/grid/nodes", fsi::rectilinear_nodes(std::vector<double>{0, 1, 2}, std::vector<double>{0, 1, 2}),
+             {9, 2});
+    XdmfWriter xdmf(dir / "fluid.xdmf", dir / "fluid.h5", fsi::XdmfStructured{"/grid/nodes", nx, ny});
     for (long step = 0; step < 5; ++step) write_fluid_step(h5, xdmf, step, nx, ny);  // t = 0 ... 0.4
   }
   H5File h5(dir / "fluid.h5", H5File::Mode::read_write);
-  XdmfWriter xdmf(dir / "fluid.xdmf", dir / "fluid.h5", fsi::XdmfRectilinear{"/grid/x", nx, "/grid/y", ny});
+  XdmfWriter xdmf(dir / "fluid.xdmf", dir / "fluid.h5", fsi::XdmfStructured{"/grid/nodes", nx, ny});
   xdmf.resume(0.2);
   CHECK(xdmf.steps() == 3);
   CHECK(count(read_text(dir / "fluid.xdmf"), "<Time ") == 3);
@@ -204,7 +210,7 @@ TEST_CASE("resume keeps the steps up to the restart time", "[xdmf]") {
   CHECK(fsi::xdmf_check(dir / "fluid.xdmf").empty());
   python_check(dir / "fluid.xdmf", 4);
 
-  XdmfWriter fresh(dir / "other.xdmf", dir / "fluid.h5", fsi::XdmfRectilinear{"/grid/x", nx, "/grid/y", ny});
+  XdmfWriter fresh(dir / "other.xdmf", dir / "fluid.h5", fsi::XdmfStructured{"/grid/nodes", nx, ny});
   fresh.resume(1.0);  // no file yet: starts empty
   CHECK(fresh.steps() == 0);
 }
