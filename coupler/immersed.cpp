@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <thread>
 
 #include "clip.hpp"
@@ -308,9 +309,23 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
     fill(boxes, p, state, c, fixed_rest, out);
   };
   if (m_threads) {
-    std::thread second([&] { family(m_vb, m_vx, m_vy, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v); });
-    family(m_ub, m_ux, m_uy, m_fixed_u, m_raw_u, m_u, m_scratch_u, 0, u);
+    // An error on either thread reaches the caller (and the error funnel) once both are done.
+    std::exception_ptr second_failed;
+    std::thread second([&] {
+      try {
+        family(m_vb, m_vx, m_vy, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v);
+      } catch (...) {
+        second_failed = std::current_exception();
+      }
+    });
+    try {
+      family(m_ub, m_ux, m_uy, m_fixed_u, m_raw_u, m_u, m_scratch_u, 0, u);
+    } catch (...) {
+      second.join();
+      throw;
+    }
     second.join();
+    if (second_failed) std::rethrow_exception(second_failed);
   } else {
     family(m_ub, m_ux, m_uy, m_fixed_u, m_raw_u, m_u, m_scratch_u, 0, u);
     family(m_vb, m_vx, m_vy, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v);

@@ -237,7 +237,7 @@ FiberSystem::FiberSystem(Config config) : m_config(std::move(config)) {
 }
 
 void FiberSystem::place_root(int k, const EndPose& pose) {
-  if (m_steps > 0) fsi::fail("fiber: place_root() is for set-up, before the first step");
+  if (m_steps > 0) fsi::fail("FiberSystem::place_root() is for set-up, before the first step");
   const FiberSpec& f = m_config.fibers[k];
   Fiber& s = m_fibers[k];
   const Vec2 dir = pose.direction.normalized();

@@ -128,7 +128,7 @@ void FiberProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Fib
   const bool has_force = !in.force.empty();
   if (has_force) {
     if (static_cast<int>(in.force.size()) != sys.fiber_count())
-      fsi::fail("fiber: fiber_input has forces for {} fibers, expected {}", in.force.size(), sys.fiber_count());
+      fsi::fail("fiber_input has forces for {} fibers, expected {}", in.force.size(), sys.fiber_count());
     for (int k = 0; k < sys.fiber_count(); ++k) {
       const auto& f = in.force[k];
       const std::size_t o = 2 * sys.marker_offset(k);

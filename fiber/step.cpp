@@ -27,9 +27,9 @@ double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(
 
 void FiberSystem::advance(double dt, std::span<const double> external_force,
                           std::span<const EndPose> root_poses) {
-  if (!(dt > 0)) fsi::fail("fiber: advance() needs dt > 0, got {}", dt);
+  if (!(dt > 0)) fsi::fail("FiberSystem::advance() needs dt > 0, got {}", dt);
   if (!external_force.empty() && external_force.size() != m_x.size())
-    fsi::fail("fiber: the external force has {} values, expected 2 per marker = {}", external_force.size(),
+    fsi::fail("FiberSystem::advance(): the external force has {} values, expected 2 per marker = {}", external_force.size(),
               m_x.size());
   if (const std::string problem = time_step_problem(m_config, dt); !problem.empty())
     throw fsi::Error(problem);
@@ -41,7 +41,7 @@ void FiberSystem::advance(double dt, std::span<const double> external_force,
       continue;
     }
     if (static_cast<int>(root_poses.size()) != fiber_count())
-      fsi::fail("fiber: {} root poses handed in, expected one per fiber ({})", root_poses.size(), fiber_count());
+      fsi::fail("FiberSystem::advance(): {} root poses handed in, expected one per fiber ({})", root_poses.size(), fiber_count());
     const EndPose& p = root_poses[k];
     const double len = p.direction.norm();
     if (!(len > 0) || !std::isfinite(len) || !p.position.allFinite())
