@@ -47,9 +47,10 @@ def h5_datasets(path):
     return out
 
 
-def compare_dirs(first, second):
+def compare_dirs(first, second, new=None):
     """The first difference between two output folders as a message, or None; and the count of
-    files and datasets compared."""
+    files and datasets compared. With `new` (a list), datasets that only the second folder's .h5
+    files hold are appended to it instead of counting as a difference."""
     compared = 0
     names = lambda d, ext: sorted(os.path.basename(p) for p in glob.glob(os.path.join(d, ext)))
     for ext in ("*.csv", "*.h5"):
@@ -63,7 +64,10 @@ def compare_dirs(first, second):
         d1 = h5_datasets(os.path.join(first, name))
         d2 = h5_datasets(os.path.join(second, name))
         if sorted(d1) != sorted(d2):
-            return f"{name} holds other datasets", compared
+            missing, extra = sorted(set(d1) - set(d2)), sorted(set(d2) - set(d1))
+            if missing or new is None:
+                return f"{name} holds other datasets (missing {missing}, new {extra})", compared
+            new += [f"{name}:{key}" for key in extra]
         for key, v in d1.items():
             if v.shape != d2[key].shape or not np.array_equal(v, d2[key], equal_nan=v.dtype.kind == "f"):
                 return f"{name}:{key} differs", compared
@@ -118,9 +122,12 @@ def main():
     ap.add_argument("--work", help="folder for the runs' outputs")
     ap.add_argument("--scenes", default=",".join(SCENES), help="comma-separated: " + ",".join(SCENES))
     ap.add_argument("--dirs", nargs=2, metavar=("OUT_A", "OUT_B"))
+    ap.add_argument("--allow-new", action="store_true",
+                    help="datasets that only B writes are listed, not counted as differences")
     a = ap.parse_args()
+    new = [] if a.allow_new else None
     if a.dirs:
-        diff, n = compare_dirs(*a.dirs)
+        diff, n = compare_dirs(*a.dirs, new)
         if diff:
             sys.exit(f"compare_outputs: {diff}")
         print(f"compare_outputs: {n} files and datasets identical")
@@ -143,8 +150,10 @@ def main():
         finally:
             if temporary:
                 os.remove(scene)
-        diff, n = compare_dirs(*outs)
-        print(f"{name}: " + (f"DIFFERS: {diff}" if diff else f"{n} files and datasets identical"))
+        before = len(new) if new is not None else 0
+        diff, n = compare_dirs(*outs, new)
+        added = f" (new in B: {', '.join(sorted(set(new[before:])))})" if new and len(new) > before else ""
+        print(f"{name}: " + (f"DIFFERS: {diff}" if diff else f"{n} files and datasets identical{added}"))
         if diff:
             failed.append(name)
     if failed:
