@@ -1,20 +1,25 @@
 #!/usr/bin/python3
-"""Generic post-processing of a run folder: one PNG of every probe CSV's columns against time.
+"""Generic post-processing of a run folder: picture.png (the last output step's fluid field, the
+bodies' meshes, the fibers and the probes' histories, chosen from what the run wrote: see
+runs/lib/picture.py) and one PNG of every CSV's columns against time.
 
-usage: plot_run.py [OUT_DIR]   (./fsi run calls it when the scene's folder has no plot.py)
+usage: plot_run.py [OUT_DIR] [--no-csv]   (./fsi run calls it when the scene's folder has no plot.py)
 """
 import argparse
 import glob
 import os
+import sys
 
-import matplotlib
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
+import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+import picture  # noqa: E402
 
 
-def main(out):
+def csv_plots(out):
     made = []
     for csv in sorted(glob.glob(os.path.join(out, "*.csv"))):
         with open(csv) as f:
@@ -36,13 +41,21 @@ def main(out):
         fig.savefig(png, dpi=110)
         plt.close(fig)
         made.append(png)
+    return made
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("out", nargs="?", default=".", help="the run's output folder")
+    p.add_argument("--no-csv", action="store_true", help="only picture.png, no plot per CSV file")
+    a = p.parse_args()
+    if not os.path.isdir(a.out):
+        raise SystemExit(f"plot_run.py: no output folder {a.out}")
+    print("picture:", os.path.relpath(picture.picture(a.out)))
+    made = [] if a.no_csv else csv_plots(a.out)
     if made:
         print("plots:", ", ".join(os.path.relpath(p) for p in made))
-    else:
-        print("no probe files to plot in", out)
 
 
 if __name__ == "__main__":
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("out", nargs="?", default=".", help="the run's output folder")
-    main(p.parse_args().out)
+    main()
