@@ -34,6 +34,8 @@ usage: ./fsi COMMAND [ARGS]
   build                       install missing packages, configure and build (incremental)
   deps                        install missing Debian packages (as root) or list them
   mpirun SCENE                print the mpirun line for SCENE without running it
+  movie OUTDIR [--fps N]      an MP4 of a run's output steps, OUTDIR/movie.mp4 (installs ffmpeg)
+  report                      speed against error of what validate and bench wrote: out/report/
   help                        this text
 TXT
 }
@@ -131,12 +133,13 @@ run() {
   compose "$scene" --out-dir "$dir" "${overwrite[@]}"
   say "running: ${CMD[*]}"
   "${CMD[@]}"
+  [ -d "$dir" ] || die "the output folder ${dir#$ROOT/}/ is gone (deleted during the run?)"
   # Post-processing: the scene's own plot script if its folder has one, else the generic one.
   local plot=$(dirname "$scene")/plot.py
   [ -x "$plot" ] || plot=$ROOT/runs/plot_run.py
-  FSI_ROOT=$ROOT FSI_OUT=$dir /usr/bin/python3 "$plot" "$dir" || say "post-processing failed"
+  FSI_ROOT=$ROOT FSI_OUT=$dir /usr/bin/python3 "$plot" "$dir" || die "post-processing failed: $plot $dir"
   say "output in ${dir#$ROOT/}/"
-  ls "$dir"/*.png >/dev/null 2>&1 && say "picture: $(ls "$dir"/*.png | head -1 | sed "s|$ROOT/||")"
+  ls "$dir"/*.png >/dev/null 2>&1 && say "picture: $(ls "$dir"/picture.png "$dir"/*.png 2>/dev/null | head -1 | sed "s|$ROOT/||")"
   return 0
 }
 
@@ -305,6 +308,24 @@ print("  work ahead on a thread of its own at nice 19 (so a waking coupler gets 
 PY
 }
 
+# movie OUTDIR [ARGS]: an MP4 of a run folder (runs/movie.py); ffmpeg is installed only for this,
+# so that a newcomer's `./fsi run` stays light.
+movie() {
+  local dir=${1:-}
+  [ -n "$dir" ] || die "usage: ./fsi movie OUTDIR [--fps N] (a run's output folder, e.g. out/default)"
+  [ -d "$dir" ] || die "no output folder '$dir'"
+  shift
+  deps ffmpeg
+  /usr/bin/python3 "$ROOT/runs/movie.py" "$dir" "$@"
+}
+
+# report [ARGS]: speed against error of the validated cases and the benchmarks (runs/report.py),
+# from out/<case>/summary.json and out/bench/*.json into out/report/index.html.
+report() {
+  deps
+  /usr/bin/python3 "$ROOT/runs/report.py" --out "$ROOT/out" "$@"
+}
+
 cmd=${1:-help}
 [ $# -gt 0 ] && shift
 case "$cmd" in
@@ -314,6 +335,8 @@ case "$cmd" in
   bench) bench "$@" ;;
   build) build ;;
   deps) deps ;;
+  movie) movie "$@" ;;
+  report) report "$@" ;;
   mpirun) build >/dev/null; compose "$(realpath "${1:?scene}")"; echo "${CMD[*]}" ;;
   help | -h | --help) usage ;;
   *) usage; die "unknown command '$cmd'" ;;
