@@ -50,19 +50,36 @@ def reported(value, reference=None):
     return metric(value, reference, err, None)
 
 
+def run_entry(error, grid, dt, quantity, reference=None):
+    """One run of a grid or time-step sequence for the report (runs/report.py): the error of
+    `quantity` (against `reference`, a value) on `grid` (text, e.g. "64x64") with time step dt
+    (None: static), and the wall and CPU time of the case's last job (job.RUNS[-1]; CPU None for a reused run)."""
+    r = job.RUNS[-1] if job.RUNS else {}
+    return {"run": r.get("name"), "quantity": quantity, "grid": str(grid),
+            "dt": None if dt is None else float(dt),
+            "error": float(error), "reference": None if reference is None else float(reference),
+            "wall_s": r.get("wall_s"), "cpu_s": r.get("cpu_s")}
+
+
 def _fmt(x, spec=".6g"):
     return "-" if x is None else format(x, spec)
 
 
-def finish(case, metrics, extra=None, short=False, name="summary.json"):
+def finish(case, metrics, extra=None, short=False, name="summary.json", per_run=None,
+           reference=None):
     """Write job.OUT/name (metrics, extra, the jobs' wall and CPU time); print each metric; exit
-    1 when a judged metric fails."""
+    1 when a judged metric fails. per_run: run_entry() of each run of a grid or time-step
+    sequence; reference: where the reference values come from (text)."""
     runs = job.RUNS
     cpu = [r["cpu_s"] for r in runs if r.get("cpu_s") is not None]
     bad = [k for k, m in metrics.items() if m["pass"] is False]
     s = {"case": case, "short": short, "pass": not bad, "metrics": metrics,
          "wall_s": sum(r["wall_s"] for r in runs), "cpu_s": sum(cpu) if cpu else None,
          "jobs": runs}
+    if per_run is not None:
+        s["per_run"] = per_run
+    if reference is not None:
+        s["reference_source"] = reference
     s.update(extra or {})
     path = os.path.join(job.OUT, name)
     with open(path, "w") as f:

@@ -7,7 +7,8 @@ What is shown when:
   parallel (its vorticity varies along one axis only: averaging it along x or along y leaves
   less than 5 % of its RMS, as in a pressure-driven channel or a shear layer) or at rest; its
   vorticity then only restates the profile's slope, and the speed |u| is shown instead. The rule
-  is applied to the last output step and holds for every frame of a movie.
+  is applied to the last output step and holds for every frame of a movie, as does its colour
+  scale (the 98th percentile of |field| at the last step).
 - solid.h5: every body's mesh at the output step nearest in time, rigid bodies dark, elastic
   ones light, element edges drawn; rigid planes of contact (solid.plane) as hatched lines.
 - fiber.h5: every fiber's markers and segments.
@@ -98,8 +99,9 @@ class Run:
         for _, f in states:
             self.fields.append(f["vorticity"] if self.field == "vorticity"
                                else np.hypot(f["u"], f["v"]))
-        # One colour scale for every frame: the largest of the frames' 98th percentiles.
-        top = max(float(np.percentile(np.abs(f), 98)) for f in self.fields)
+        # One colour scale for every frame, the last one's (the picture's): the 98th percentile
+        # of |field|, so that a start-up transient or a corner singularity does not wash it out.
+        top = float(np.percentile(np.abs(self.fields[-1]), 98))
         self.limit = top if np.isfinite(top) and top > 0 else 1.0
 
     def _read_solid(self):

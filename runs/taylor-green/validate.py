@@ -16,7 +16,7 @@ import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from metrics import finish, metric  # noqa: E402
+from metrics import finish, metric, run_entry  # noqa: E402
 
 ARGS = cli.parser(__doc__).parse_args()
 OUT = job.out_dir("taylor-green")
@@ -68,7 +68,7 @@ def l2_exact(d, nu):
     return np.sqrt((np.mean(du ** 2) + np.mean(dv ** 2)) / 2)
 
 
-metrics, table = {}, []
+metrics, table, per_run = {}, [], []
 grids = [16, 32, 64] if ARGS.short else [32, 64, 128]
 for diffusion in ["explicit", "implicit"]:
     errs = []
@@ -76,6 +76,7 @@ for diffusion in ["explicit", "implicit"]:
         dt = 0.02 * (32 / n) ** 2  # dt ~ h^2: the time error falls with the space error
         d, wall = run(n, dt, diffusion)
         errs.append(l2_exact(d, 0.05))
+        per_run.append(run_entry(errs[-1], f"{n}x{n}", dt, f"L2 velocity error, {diffusion}", 0.0))
         table.append({"diffusion": diffusion, "n": n, "dt": dt, "l2_error": errs[-1], "wall_s": wall})
     orders = np.log2(np.array(errs[:-1]) / np.array(errs[1:]))
     metrics[f"space_order_{diffusion}"] = metric(orders[-1], 2.0, max(0.0, 1.9 - orders[-1]), 0.0)
@@ -107,4 +108,5 @@ limit = 1.0 / (4 * nu * 2 / h ** 2)
 d, _ = run(n, 4 * limit, "implicit", nu=nu, t_end=200 * limit)
 e = l2_exact(d, nu) / np.exp(-2 * nu * d["time"])  # error relative to the current amplitude
 metrics["implicit_4x_limit_relative_error"] = metric(e, 0.0, e, 0.05)
-finish("taylor-green", metrics, {"runs": table, "explicit_limit_dt": limit}, short=ARGS.short)
+finish("taylor-green", metrics, {"runs": table, "explicit_limit_dt": limit}, short=ARGS.short,
+       per_run=per_run, reference="exact decaying Taylor-Green vortex (L2 velocity error at t = 1)")

@@ -20,7 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import outputs  # noqa: E402
-from metrics import finish, metric, relative  # noqa: E402
+from metrics import finish, metric, relative, run_entry  # noqa: E402
 
 _p = cli.parser(__doc__)
 _p.add_argument("--dt-study", action="store_true", help="the forces against the time step")
@@ -163,7 +163,7 @@ def vorticity_plot(folder, title, path):
 
 
 def main():
-    metrics, rows = {}, []
+    metrics, rows, per_run = {}, [], []
     fig, axes = plt.subplots(len(RUN_CASES), 2, figsize=(11, 3.2 * len(RUN_CASES)), squeeze=False)
     conv = {}
     for ci, case in enumerate(RUN_CASES):
@@ -183,6 +183,9 @@ def main():
                    "lift_error": abs(l["value"] - ref["lift"]) / ref["lift"]}
             rows.append(row)
             results.append(row)
+            for q in ["drag", "lift"]:
+                per_run.append(run_entry(row[f"{q}_error"], f"{row['cells'][0]}x{n}", dt,
+                                         f"{case} {q}, relative error", ref[q]))
             print(f"{case} h = 0.41/{n} ({row['cells'][0]} x {n}, {steps} steps, {wall:.0f} s): "
                   f"drag {d['value']:.4f} +- {d['amplitude']:.3g} ({100 * row['drag_error']:.2f} %), "
                   f"lift {l['value']:.4f} +- {l['amplitude']:.3g} ({100 * row['lift_error']:.2f} %)"
@@ -256,7 +259,9 @@ def main():
             "observed_order": {c: {q: {"against_reference": [finite(o) for o in v[0]],
                                        "successive": finite(v[1])}
                                    for q, v in d.items()} for c, d in conv.items()}},
-           short=SHORT)
+           short=SHORT, per_run=per_run,
+           reference="Turek & Hron 2006, CFD1 drag 14.29, lift 1.119; CFD2 drag 136.7, lift 10.53"
+                     " (runs/turek-hron-cfd/reference.csv)")
 
 
 
