@@ -51,7 +51,8 @@ def main():
     a = p.parse_args()
     if not os.path.isdir(a.out):
         raise SystemExit(f"plot_run.py: no output folder {a.out}")
-    print("picture:", os.path.relpath(picture.picture(a.out)))
+    png, shows = picture.picture(a.out)
+    print(f"picture: {os.path.relpath(png)} ({shows})")
     made = [] if a.no_csv else csv_plots(a.out)
     if made:
         print("plots:", ", ".join(os.path.relpath(p) for p in made))

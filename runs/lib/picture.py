@@ -166,6 +166,13 @@ class Run:
                              "more": max(0, len(lines) - MAX_PROBES)})
         return axes
 
+    def contents(self):
+        """What the picture shows, in words: 'shows: vorticity, bodies, fibers; histories: ...'."""
+        what = ([self.field] if self.has_fluid else []) + (["bodies"] if self.bodies else []) + \
+            (["planes"] if self.planes else []) + (["fibers"] if self.fiber_markers else [])
+        hist = [f"{h['label']} {h['quantity']}" for h in self.probes]
+        return f"shows: {', '.join(what)}; histories: {', '.join(hist) or 'none'}"
+
     def box(self):
         """The view: the fluid's domain, else the box around all bodies and fibers of all steps."""
         if self.has_fluid:
@@ -291,10 +298,11 @@ def draw(run, k, cursor=False):
 
 
 def picture(folder, png=None, dpi=120):
-    """Draw the last output step of a run folder into png (default folder/picture.png)."""
+    """Draw the last output step of a run folder into png (default folder/picture.png); returns
+    the PNG's path and what it shows (Run.contents)."""
     run = Run(folder)
     png = png or os.path.join(folder, "picture.png")
     fig = draw(run, len(run.times) - 1)
     fig.savefig(png, dpi=dpi)
     plt.close(fig)
-    return png
+    return png, run.contents()
