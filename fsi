@@ -139,7 +139,7 @@ run() {
   [ -x "$plot" ] || plot=$ROOT/runs/plot_run.py
   FSI_ROOT=$ROOT FSI_OUT=$dir /usr/bin/python3 "$plot" "$dir" || die "post-processing failed: $plot $dir"
   say "output in ${dir#$ROOT/}/"
-  ls "$dir"/*.png >/dev/null 2>&1 && say "picture: $(ls "$dir"/picture.png "$dir"/*.png 2>/dev/null | head -1 | sed "s|$ROOT/||")"
+  ls "$dir"/*.png >/dev/null 2>&1 && say "picture: $(ls -U "$dir"/picture.png "$dir"/*.png 2>/dev/null | head -1 | sed "s|$ROOT/||")"
   return 0
 }
 
