@@ -53,7 +53,7 @@ def cases(out):
 
 def machine():
     """Cores, CPU model, memory, date and the git commit of the tree."""
-    model, mem = "unknown", "unknown"
+    model, mem, load = "unknown", "unknown", "unknown"
     try:
         for ln in open("/proc/cpuinfo"):
             if ln.startswith("model name"):
@@ -63,6 +63,7 @@ def machine():
             if ln.startswith("MemTotal"):
                 mem = f"{int(ln.split()[1]) / 2 ** 20:.1f} GiB"
                 break
+        load = open("/proc/loadavg").read().split()[0]
     except OSError:
         pass
     root = os.path.abspath(os.path.join(HERE, "..", ".."))
@@ -73,7 +74,7 @@ def machine():
     commit = git("rev-parse", "HEAD") or "unknown (not a git checkout)"
     if git("status", "--porcelain", "--untracked-files=no"):
         commit += " (with uncommitted changes)"
-    return {"cores": os.cpu_count(), "cpu": model, "memory": mem, "commit": commit,
+    return {"cores": os.cpu_count(), "cpu": model, "memory": mem, "load": load, "commit": commit,
             "date": datetime.datetime.now().strftime("%Y-%m-%d %H:%M")}
 
 
@@ -227,7 +228,9 @@ def write(out, dest, runs_dir):
     h = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>fsi: speed against error"
          f"</title><style>{CSS}</style></head><body>",
          "<h1>Speed against error</h1>",
-         f"<p>Machine: {m['cores']} cores, {html.escape(m['cpu'])}, {m['memory']}. "
+         f"<p>Machine: {m['cores']} cores, {html.escape(m['cpu'])}, {m['memory']}, load average {m['load']} "
+         f"while this page was written (the timings below were taken when their runs ran; on a "
+         f"shared machine compare CPU, not wall). "
          f"Written {m['date']} from commit <code>{html.escape(m['commit'])}</code>. Cases from "
          f"<code>{html.escape(out)}/&lt;case&gt;/summary.json</code> (<code>./fsi validate"
          f"</code>; short modes as marked), benchmarks from <code>out/bench/*.json</code> "
@@ -316,6 +319,8 @@ def write(out, dest, runs_dir):
         png = case_plot(c, {}, by_case[c], dest)
         if png:
             h.append(f"<p><img src='{png}' alt='{c}: peers, error against CPU time'></p>")
+        else:
+            h.append("<p class=note>Only the peers' numbers, without timings (table below).</p>")
 
     h.append("<h2>Peers</h2><p>From <code>runs/lib/peers.csv</code> (its header says how they "
              "were measured): CPU is user + system of the whole run, single-threaded, on a 2-core "
