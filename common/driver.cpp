@@ -1,6 +1,7 @@
 // serve(): the solver side of the step sequence (see driver.hpp and common/PROTOCOL.md).
 #include "driver.hpp"
 
+#include "checkpoint.hpp"
 #include "progress.hpp"
 #include "summary.hpp"
 
@@ -14,13 +15,28 @@ namespace fsi {
 // fraction of an interval below a multiple count as that multiple (round-off of n dt).
 constexpr double kIntervalTolerance = 1e-9;
 
+namespace {
+// Whether t^n is the first step time of a new multiple of `interval`.
+bool crosses(const CommonSettings& s, double interval, long n) {
+  const double k_now = std::floor(step_time(s, n) / interval + kIntervalTolerance);
+  const double k_before = std::floor(step_time(s, n - 1) / interval + kIntervalTolerance);
+  return k_now > k_before;
+}
+}  // namespace
+
 bool is_output_step(const CommonSettings& s, long n) {
   if (s.output_interval <= 0) return false;
   if (n == 0 || n == s.steps) return true;
-  const double k_now = std::floor(step_time(s, n) / s.output_interval + kIntervalTolerance);
-  const double k_before = std::floor(step_time(s, n - 1) / s.output_interval + kIntervalTolerance);
-  return k_now > k_before;
+  return crosses(s, s.output_interval, n);
 }
+
+bool is_checkpoint_step(const CommonSettings& s, long n) {
+  if (s.checkpoint_interval <= 0 || n <= 0) return false;
+  return n == s.steps || crosses(s, s.checkpoint_interval, n);
+}
+
+void SolverPort::save(H5File&) const { fail("this program cannot write checkpoints"); }
+void SolverPort::load(const H5File&) { fail("this program cannot restart from a checkpoint"); }
 
 void write_summary(const Runtime& rt, const nlohmann::json& summary) {
   write_file_atomically(rt.out_dir() / "summary.json", summary.dump(2) + "\n");
@@ -51,22 +67,31 @@ template <class Port, class Advance>
 void run_alone(Runtime& rt, Port& port, Advance advance) {
   const auto& s = rt.settings();
   write_file_atomically(rt.out_dir() / "scene.effective.toml", rt.scene().effective_toml());
-  port.output(0, 0.0, is_output_step(s, 0));
+  const long first = rt.first_step();
+  if (!rt.restart_step()) port.output(0, 0.0, is_output_step(s, 0));
   Progress::Options po;
   po.every_steps = s.progress_every;
+  po.first_step = first;
+  po.first_time = step_time(s, first);
   Progress progress(fmt::format("[{}]", rt.name()), s.steps, step_time(s, s.steps), po);
-  for (long n = 0; n < s.steps; ++n) {
+  long n = first;
+  while (n < s.steps) {
     rt.check_fault(n);
     const proto::StepBegin sb{n, step_time(s, n), s.dt, proto::Action::step};
     advance(sb);
-    port.output(n + 1, step_time(s, n + 1), is_output_step(s, n + 1));
-    progress.update(n + 1, step_time(s, n + 1), s.dt, [&] { return port.status(); });
+    ++n;
+    port.output(n, step_time(s, n), is_output_step(s, n));
+    progress.update(n, step_time(s, n), s.dt, [&] { return port.status(); });
+    const bool stop = rt.stop_requested();
+    if (stop || is_checkpoint_step(s, n))
+      write_checkpoint(rt, n, [&](H5File& h5) { port.save(h5); });
+    if (stop) break;
   }
-  nlohmann::json j = base_summary(rt, s.steps);
+  nlohmann::json j = base_summary(rt, n);
   j["wall_time"][rt.name()] = rt.wall_seconds();
   j[rt.name()] = port.report();
   write_summary(rt, j);
-  progress.finish(s.steps, step_time(s, s.steps), fmt::format("output in {}", rt.out_dir().string()));
+  progress.finish(n, step_time(s, n), fmt::format("output in {}", rt.out_dir().string()));
 }
 
 // Coupled: follow the coupler's step_begin messages until it says stop. A step is committed,
@@ -78,22 +103,26 @@ void follow(Runtime& rt, Port& port, Advance advance) {
   Link& c = rt.coupler_link();
   c.send(proto::Text{proto::Tag::effective_scene, rt.scene().effective_toml()});
   const auto& s = rt.settings();
-  port.output(0, 0.0, is_output_step(s, 0));
-  long steps = 0, repeats = 0;
+  if (!rt.restart_step()) port.output(0, 0.0, is_output_step(s, 0));
+  long steps = rt.first_step(), repeats = 0;
   // Wall time inside the port's step (its whole computation between receiving its input and
   // sending its answer): the coupler's time for this solver's phase minus this is the messages'.
   // And the work done ahead of the input (begin, prepare_next), outside that phase.
   double port_seconds = 0, ahead_seconds = 0;
   bool pending = false;  // step `steps` - 1 is done but not yet committed
+  bool pending_checkpoint = false;  // ... and its state is to be checkpointed once committed
   double t_done = 0;
+  // The committed step `steps` (state at t_done): its output, and its checkpoint when asked.
+  auto commit_step = [&](bool checkpoint) {
+    port.output(steps, t_done, is_output_step(s, steps));
+    if (checkpoint) write_checkpoint(rt, steps, [&](H5File& h5) { port.save(h5); });
+    pending = false;
+  };
   for (;;) {
     proto::StepBegin sb;
     c.recv(sb);
     const bool commit = sb.action == proto::Action::stop || sb.iteration == 0;
-    if (pending && commit) {
-      port.output(steps, t_done, is_output_step(s, steps));
-      pending = false;
-    }
+    if (pending && commit) commit_step(pending_checkpoint);
     if (sb.action == proto::Action::stop) break;
     const long expected = sb.iteration == 0 ? steps : steps - 1;
     if (sb.step != expected || sb.iteration < 0 || (sb.iteration > 0 && !pending))
@@ -109,11 +138,13 @@ void follow(Runtime& rt, Port& port, Advance advance) {
     steps = sb.step + 1;
     t_done = sb.time + sb.dt;
     pending = true;
+    pending_checkpoint = sb.checkpoint != 0;
     if (sb.may_repeat == 0) {
-      // A step that cannot be repeated is final once answered: commit it now, then work ahead.
-      port.output(steps, t_done, is_output_step(s, steps));
-      pending = false;
-      if (s.work_ahead && steps < s.steps) timed(ahead_seconds, [&] { port.prepare_next(sb); });
+      // A step that cannot be repeated is final once answered: commit it now, then work ahead
+      // (not after a checkpoint: the coupler may stop the run there).
+      commit_step(pending_checkpoint);
+      if (s.work_ahead && steps < s.steps && !sb.checkpoint)
+        timed(ahead_seconds, [&] { port.prepare_next(sb); });
     }
   }
   nlohmann::json j = port.report();
@@ -148,6 +179,7 @@ void follow_state(Runtime& rt, Port& port, In& in, State& st, bool can_iterate) 
 }  // namespace
 
 void serve(Runtime& rt, FluidPort& port) {
+  if (rt.restart_step()) port.load(open_restart(rt));
   proto::FluidInput in;
   proto::FluidOutput out;
   if (!rt.coupled()) return run_alone(rt, port, [&](const proto::StepBegin& sb) {
@@ -166,6 +198,7 @@ void serve(Runtime& rt, FluidPort& port) {
 }
 
 void serve(Runtime& rt, SolidPort& port) {
+  if (rt.restart_step()) port.load(open_restart(rt));
   proto::SolidInput in;
   proto::SolidState st;
   if (!rt.coupled()) return run_alone(rt, port, [&](const proto::StepBegin& sb) {
@@ -181,6 +214,7 @@ void serve(Runtime& rt, SolidPort& port) {
 }
 
 void serve(Runtime& rt, FiberPort& port) {
+  if (rt.restart_step()) port.load(open_restart(rt));
   proto::FiberInput in;
   proto::FiberState st;
   if (!rt.coupled()) return run_alone(rt, port, [&](const proto::StepBegin& sb) {

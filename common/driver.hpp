@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "h5.hpp"
 #include "protocol.hpp"
 #include "runtime.hpp"
 
@@ -31,6 +32,13 @@ class SolverPort {
   // step_begin for a new step (iteration 0), after the previous step's output, before its input.
   virtual void prepare_next(const proto::StepBegin& done) { (void)done; }
   virtual void begin(const proto::StepBegin& s) { (void)s; }
+  // Checkpoint and restart (common/checkpoint.hpp). save(): after a committed step and its
+  // output, everything the next step reads (fields, histories, states of the outputs) into `h5`.
+  // load(): in a restarted run, before anything is sent or written, the same back; the port has
+  // already reopened its output files to continue them (their rows up to the restart time kept).
+  // A run stopped and restarted gives the same results bit for bit. The default refuses.
+  virtual void save(H5File& h5) const;
+  virtual void load(const H5File& h5);
 };
 
 // Coupled iterations (common/PROTOCOL.md, "Coupled iterations"): a fluid or solid port that
@@ -83,6 +91,9 @@ inline double step_time(const CommonSettings& s, long n) { return static_cast<do
 // Whether fields are written after step n: at every multiple of the output interval (and at the
 // last step); never when the interval is 0.
 bool is_output_step(const CommonSettings& s, long n);
+// Whether a checkpoint is written after step n: at every multiple of output.checkpoint_interval
+// and at the last step; never when the interval is 0.
+bool is_checkpoint_step(const CommonSettings& s, long n);
 
 // Write out_dir/summary.json (atomically).
 void write_summary(const Runtime& rt, const nlohmann::json& summary);

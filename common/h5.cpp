@@ -183,6 +183,26 @@ bool H5File::exists(std::string_view name) const {
   return true;
 }
 
+std::vector<std::string> H5File::children(std::string_view group) const {
+  std::vector<std::string> names;
+  const std::string path = object_name(group);
+  auto collect = [](hid_t, const char* name, const H5L_info_t*, void* out) -> herr_t {
+    static_cast<std::vector<std::string>*>(out)->push_back(name);
+    return 0;
+  };
+  if (H5Literate_by_name(m_id, path.c_str(), H5_INDEX_NAME, H5_ITER_INC, nullptr, collect, &names,
+                          H5P_DEFAULT) < 0)
+    raise("cannot list the members of", path);
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+void H5File::remove(std::string_view name) {
+  const std::string path = object_name(name);
+  if (H5Ldelete(m_id, path.c_str(), H5P_DEFAULT) < 0) raise("cannot remove", path);
+  flush();
+}
+
 void H5File::create_group(std::string_view name) {
   std::string path = object_name(name);
   if (exists(path)) return;

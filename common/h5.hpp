@@ -45,6 +45,10 @@ class H5File {
   // shape agree, as a checkpoint rewritten each time does).
   void create_group(std::string_view name);
   bool exists(std::string_view name) const;
+  // The names of a group's members (links), sorted; remove() unlinks one (a restart drops the
+  // output steps beyond its step).
+  std::vector<std::string> children(std::string_view group) const;
+  void remove(std::string_view name);
 
   // Store `data` (row-major, product of `shape` values) as 64-bit floats or integers.
   void write(std::string_view name, std::span<const double> data, const H5Shape& shape = {});

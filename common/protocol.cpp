@@ -112,9 +112,11 @@ void Text::unpack(Reader& r) { r.get(text); }
 
 void StepBegin::pack(Writer& w) const {
   w.put(step), w.put(time), w.put(dt), w.put(action), w.put(iteration), w.put(may_repeat);
+  w.put(checkpoint);
 }
 void StepBegin::unpack(Reader& r) {
   r.get(step), r.get(time), r.get(dt), r.get(action), r.get(iteration), r.get(may_repeat);
+  r.get(checkpoint);
 }
 
 void FluidInput::pack(Writer& w) const {

@@ -17,7 +17,7 @@
 namespace fsi::proto {
 
 // Bump on any change of a message's layout or of the message order.
-inline constexpr std::int32_t kVersion = 4;
+inline constexpr std::int32_t kVersion = 5;
 inline constexpr std::uint32_t kMagic = 0x4d495346;  // "FSIM"
 
 enum class Tag : std::int32_t {
@@ -84,7 +84,7 @@ class Reader {
     if (n < 0 || static_cast<std::size_t>(n) > (m_size - m_pos) / sizeof(T))
       fail("protocol error: vector length {} does not fit the message", n);
     v.resize(static_cast<std::size_t>(n));
-    std::memcpy(v.data(), m_data + m_pos, v.size() * sizeof(T));
+    if (n > 0) std::memcpy(v.data(), m_data + m_pos, v.size() * sizeof(T));
     m_pos += v.size() * sizeof(T);
   }
   void get(std::string& s);
@@ -180,6 +180,9 @@ struct StepBegin {  // coupler -> each solver, every step
   // 1 when coupled iterations are on, so that this step may be redone: a solver keeps what a
   // redo needs only then (the fluid's predictor fields, three copies of the grid per step).
   std::int32_t may_repeat = 0;
+  // 1: once this step is committed, write a checkpoint of the state at t^(n+1) (common/driver.hpp,
+  // SolverPort::save) before any work ahead of the next step.
+  std::int32_t checkpoint = 0;
   void pack(Writer& w) const;
   void unpack(Reader& r);
 };

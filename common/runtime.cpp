@@ -3,9 +3,13 @@
 
 #include <unistd.h>
 
+#include <csignal>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <thread>
+
+#include "checkpoint.hpp"
 
 namespace fsi {
 
@@ -37,6 +41,10 @@ constexpr int kLinkTagBase = 7100;
 // t_end / dt within this relative distance of an integer is that many steps (round-off of the
 // division); further away, the step count rounds up.
 constexpr double kStepCountTolerance = 1e-9;
+
+// Set by SIGUSR1 (./fsi sends it when it is asked to stop; mpirun forwards it to every program).
+volatile std::sig_atomic_t g_stop_signal = 0;
+extern "C" void on_stop_signal(int) { g_stop_signal = 1; }
 
 // A waiting program tests its request and yields the core between tests: with more programs
 // than cores it hands the core to a program ready to run there, and picks its message up at the
@@ -85,12 +93,23 @@ RoleSet roles_needed(const SceneTable& root) {
 Options parse_options(int argc, char** argv, const char* role) {
   Options o;
   const std::string usage =
-      fmt::format("usage: {} SCENE.toml [--out ROOT | --out-dir DIR] [--overwrite]", role);
+      fmt::format("usage: {} SCENE.toml [--out ROOT | --out-dir DIR] [--overwrite] "
+                  "[--restart DIR] [--time-limit SECONDS]", role);
   std::vector<std::string> positional;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--overwrite") o.overwrite = true;
-    else if (a == "--out" || a == "--out-dir") {
+    else if (a == "--restart") {
+      if (i + 1 >= argc) throw InputError(fmt::format("--restart needs the folder of the run; {}", usage));
+      o.restart = std::filesystem::path(argv[++i]);
+    } else if (a == "--time-limit") {
+      if (i + 1 >= argc) throw InputError(fmt::format("--time-limit needs a number of seconds; {}", usage));
+      const std::string v = argv[++i];
+      char* end = nullptr;
+      o.time_limit = std::strtod(v.c_str(), &end);
+      if (end == v.c_str() || *end != '\0' || !(o.time_limit > 0) || !std::isfinite(o.time_limit))
+        throw InputError(fmt::format("--time-limit must be a number of seconds > 0, got '{}'", v));
+    } else if (a == "--out" || a == "--out-dir") {
       if (i + 1 >= argc) throw InputError(fmt::format("{} needs a folder; {}", a, usage));
       if (a == "--out") o.out_root = argv[++i];
       else o.out_dir = std::filesystem::path(argv[++i]);
@@ -101,6 +120,9 @@ Options parse_options(int argc, char** argv, const char* role) {
   if (positional.size() != 1)
     throw InputError(fmt::format("expected one scene file, got {}; {}", positional.size(), usage));
   o.scene = positional[0];
+  if (o.restart && (o.out_dir || o.overwrite || o.out_root != "out"))
+    throw InputError(fmt::format("--restart resumes in its own folder: it takes no --out, --out-dir "
+                                 "or --overwrite; {}", usage));
   return o;
 }
 
@@ -130,6 +152,7 @@ CommonSettings read_common(const SceneTable& root) {
   if (const auto out = root.optional_table("output")) {
     s.output_interval = out->non_negative("interval", 0.0);
     s.progress_every = out->integer("progress", 0);
+    s.checkpoint_interval = out->non_negative("checkpoint_interval", 0.0);
     if (s.progress_every < 0) out->fail("progress", fmt::format("must be >= 0, got {}", s.progress_every));
     out->finish();
   }
@@ -205,6 +228,10 @@ Link& Runtime::link(Role solver) {
 
 double Runtime::wall_seconds() const { return MPI_Wtime() - m_t0; }
 
+bool Runtime::stop_requested() const {
+  return g_stop_signal != 0 || (m_time_limit > 0 && wall_seconds() > m_time_limit);
+}
+
 void Runtime::check_fault(long step) const {
   if (m_settings.fail_role == name() && step == m_settings.fail_step)
     fail("test fault injected at step {} (test.fail_role = \"{}\")", step, name());
@@ -241,8 +268,9 @@ void check_job(const Runtime& rt, const std::vector<Announce>& all, const RoleSe
            "every process, same file?)",
            who, rt.name());
     if (a.options_hash != all[0].options_hash)
-      fail("{} and {} were given different output options (--out, --out-dir, --overwrite); give "
-           "every program of the job the same arguments",
+      fail("{} and {} were given different output options (--out, --out-dir, --overwrite, --restart) "
+           "or found different checkpoints to resume from; give every program of the job the same "
+           "arguments",
            who, kRoleNames[all[0].role]);
     if (appnum[a.role] >= 0 && appnum[a.role] != a.appnum)
       fail("role '{}' was launched twice (programs {} and {} of the mpirun line); launch each "
@@ -290,6 +318,23 @@ int run_program(Role role, int argc, char** argv, const std::function<void(Runti
     rt.m_settings = read_common(root);
     for (const char* k : {"fluid", "solid", "fiber", "coupler"}) root.skip(k);
     root.finish();
+    rt.m_time_limit = opts.time_limit;
+    struct sigaction sa {};
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGUSR1, &sa, nullptr);
+    // A restart resumes from the newest step that every program of the scene completed; each
+    // program finds it alone, and the handshake checks that they agree.
+    if (opts.restart) {
+      if (!std::filesystem::is_directory(*opts.restart))
+        throw InputError(fmt::format("--restart {}: no such folder", opts.restart->string()));
+      rt.m_restart_step = newest_checkpoint(*opts.restart, rt.m_roles);
+      if (!rt.m_restart_step)
+        throw InputError(fmt::format(
+            "--restart {}: no complete checkpoint in {} (a checkpoint is written every "
+            "output.checkpoint_interval and when a run is asked to stop)",
+            opts.restart->string(), (*opts.restart / "checkpoint").string()));
+    }
 
     // Handshake: who is here, which protocol, which scene.
     Announce me{kAnnounceMagic,
@@ -301,9 +346,10 @@ int run_program(Role role, int argc, char** argv, const std::function<void(Runti
                 rt.m_scene->hash(),
                 rt.m_roles[role] ? 1 : 0,
                 0,
-                std::hash<std::string>{}(fmt::format("{}|{}|{}", opts.out_root.string(),
-                                                     opts.out_dir ? opts.out_dir->string() : "-",
-                                                     opts.overwrite))};
+                std::hash<std::string>{}(fmt::format(
+                    "{}|{}|{}|{}|{}", opts.out_root.string(), opts.out_dir ? opts.out_dir->string() : "-",
+                    opts.overwrite, opts.restart ? opts.restart->string() : "-",
+                    rt.m_restart_step.value_or(-1)))};
     std::vector<Announce> all(static_cast<std::size_t>(world_size));
     MPI_Allgather(&me, sizeof(Announce), MPI_BYTE, all.data(), sizeof(Announce), MPI_BYTE,
                   MPI_COMM_WORLD);
@@ -327,7 +373,8 @@ int run_program(Role role, int argc, char** argv, const std::function<void(Runti
     // Output folder: chosen by the first process of the job, the same for all.
     std::string dir;
     if (job_rank == 0)
-      dir = (opts.out_dir ? [&] {
+      dir = opts.restart ? opts.restart->string()
+            : (opts.out_dir ? [&] {
               if (std::filesystem::exists(*opts.out_dir) && !opts.overwrite &&
                   !std::filesystem::is_empty(*opts.out_dir))
                 throw InputError(fmt::format(

@@ -42,6 +42,10 @@ struct Options {
   std::filesystem::path out_root = "out";
   std::optional<std::filesystem::path> out_dir;  // --out-dir: exactly this folder
   bool overwrite = false;
+  // --restart DIR: resume the run in DIR from its newest complete checkpoint (output continues
+  // there); excludes --out, --out-dir and --overwrite.
+  std::optional<std::filesystem::path> restart;
+  double time_limit = 0;  // --time-limit SECONDS: checkpoint and stop after this wall time (0: none)
 };
 Options parse_options(int argc, char** argv, const char* role);
 
@@ -53,6 +57,7 @@ struct CommonSettings {
   long steps = 0;           // number of steps: t_end / dt rounded up
   double output_interval = 0;  // output.interval: field output every this much time; 0 = none
   long progress_every = 0;     // output.progress: 0 = automatic
+  double checkpoint_interval = 0;  // output.checkpoint_interval: checkpoint every this much time
   // [test]: fault switches used by the test suite only
   std::string fail_role;    // test.fail_role: this program fails ...
   long fail_step = -1;      // ... at the start of this step
@@ -104,6 +109,13 @@ class Runtime {
   Link& link(Role solver);
   bool has_link(Role r) const { return m_links[static_cast<int>(r)] != nullptr; }
   double wall_seconds() const;  // since start
+  // A restarted run: the step of the checkpoint it resumes from (nullopt: a fresh run).
+  std::optional<long> restart_step() const { return m_restart_step; }
+  // First step this run computes: 0, or the restart step.
+  long first_step() const { return m_restart_step.value_or(0); }
+  // Whether the run was asked to stop (SIGUSR1, SIGTERM or SIGINT to this program, or the wall
+  // time of --time-limit passed): checkpoint, then stop. Cheap; polled once a step.
+  bool stop_requested() const;
   // The test-only fault switch: throws when this program is told to fail at `step`.
   void check_fault(long step) const;
 
@@ -116,6 +128,8 @@ class Runtime {
   std::filesystem::path m_out_dir;
   std::array<std::unique_ptr<Link>, kRoleCount> m_links;
   double m_t0 = 0;
+  std::optional<long> m_restart_step;
+  double m_time_limit = 0;
 };
 
 // The body of a program's main. Returns the process exit code (0), or aborts the job on error.

@@ -6,12 +6,30 @@
 #include <cmath>
 #include <utility>
 
+#include "checkpoint.hpp"
+
 namespace coupler {
 
 void Acceleration::begin_step() {
   m_k = 0;
   m_now = {};
   m_columns = 0;
+}
+
+void Acceleration::save(fsi::H5File& h5, const std::string& group) const {
+  h5.write(group + "/steps", std::vector<std::int64_t>{static_cast<std::int64_t>(m_old.size())});
+  for (std::size_t k = 0; k < m_old.size(); ++k) {
+    fsi::write_vectors(h5, fmt::format("{}/{}/v", group, k), m_old[k].v);
+    fsi::write_vectors(h5, fmt::format("{}/{}/w", group, k), m_old[k].w);
+  }
+}
+
+void Acceleration::load(const fsi::H5File& h5, const std::string& group) {
+  m_old.assign(static_cast<std::size_t>(h5.read_int64s(group + "/steps").at(0)), {});
+  for (std::size_t k = 0; k < m_old.size(); ++k) {
+    m_old[k].v = fsi::read_vectors(h5, fmt::format("{}/{}/v", group, k));
+    m_old[k].w = fsi::read_vectors(h5, fmt::format("{}/{}/w", group, k));
+  }
 }
 
 void Acceleration::end_step(bool converged) {

@@ -3,7 +3,10 @@
 // previous steps'). README.md, "Coupled iterations".
 #pragma once
 
+#include <string>
 #include <vector>
+
+#include "h5.hpp"
 
 namespace coupler {
 
@@ -34,6 +37,9 @@ class Acceleration {
   // The step is over: a converged step's secant pairs join the kept ones (reuse); a step that did
   // not converge clears them all.
   void end_step(bool converged);
+  // The kept secant pairs of previous steps (between steps), in a checkpoint's group `group`.
+  void save(fsi::H5File& h5, const std::string& group) const;
+  void load(const fsi::H5File& h5, const std::string& group);
   double omega() const { return m_s.relaxation; }  // the relaxation of an update without columns
   int columns() const { return m_columns; }        // columns used by the last update
 

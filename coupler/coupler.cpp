@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "checkpoint.hpp"
 #include "driver.hpp"
 
 namespace coupler {
@@ -28,14 +29,24 @@ constexpr double kMinLoopSeconds = 1e-9;
 
 void Coupler::run() {
   setup();
+  if (m_rt.restart_step()) load(fsi::open_restart(m_rt));
   const auto& s = m_rt.settings();
+  const long first = m_rt.first_step();
   fsi::Progress::Options po;
   po.every_steps = s.progress_every;
+  po.first_step = first;
+  po.first_time = fsi::step_time(s, first);
   m_progress =
       std::make_unique<fsi::Progress>("[coupler]", s.steps, fsi::step_time(s, s.steps), po);
   m_t_start = m_rt.wall_seconds();
-  for (long n = 0; n < s.steps; ++n) step(n);
-  finish();
+  // Asked to stop (a signal, the time limit): the next step is checkpointed and is the last.
+  long n = first;
+  while (n < s.steps) {
+    m_stopping = m_stopping || m_rt.stop_requested();
+    step(n++);
+    if (m_stopping) break;
+  }
+  finish(n, first);
 }
 
 // One step t^n -> t^(n+1). With coupler.iterations.max = 1 the explicit staggered step; with
@@ -52,6 +63,7 @@ void Coupler::step(long n) {
   commit(n);            // the accepted step: exchange log, samples, force probes, growth check
   fibers(n);            // 6-7: root poses at t^(n+1) to the fiber; its step; root loads back
   report(n);
+  if (m_sb.checkpoint) fsi::write_checkpoint(m_rt, n + 1, [&](fsi::H5File& h5) { save(h5); });
 }
 
 // Send `in` to a solver and wait for its answer, timed as that solver's phase.
@@ -71,6 +83,7 @@ void Coupler::begin_step(long n) {
   const auto& s = m_rt.settings();
   m_sb =
       proto::StepBegin{n, fsi::step_time(s, n), s.dt, proto::Action::step, 0, iterates() ? 1 : 0};
+  m_sb.checkpoint = m_stopping || fsi::is_checkpoint_step(s, n + 1);
   for (Role r : {Role::fluid, Role::fiber})
     if (has(r)) m_rt.link(r).send(m_sb, n);
   m_rt.check_fault(n);
@@ -280,19 +293,21 @@ void Coupler::scatter_velocities(const std::vector<double>& x, proto::SolidState
 }
 
 // The end of the run: stop to every solver, their final reports into summary.json.
-void Coupler::finish() {
+void Coupler::finish(long steps, long first) {
   const auto& s = m_rt.settings();
-  const proto::StepBegin stop{s.steps, fsi::step_time(s, s.steps), s.dt, proto::Action::stop};
+  const proto::StepBegin stop{steps, fsi::step_time(s, steps), s.dt, proto::Action::stop};
   nlohmann::json j;
   j["scene"] = s.name;
   j["scene_file"] = m_rt.scene().file().string();
-  j["steps"] = s.steps;
-  j["time"] = fsi::step_time(s, s.steps);
+  j["steps"] = steps;
+  j["time"] = fsi::step_time(s, steps);
   j["dt"] = s.dt;
+  if (m_rt.restart_step()) j["restarted_from_step"] = first;
+  if (steps < s.steps) j["stopped_at_step"] = steps;
   for (Role r : {Role::fluid, Role::solid, Role::fiber}) {
     if (!has(r)) continue;
     auto& l = m_rt.link(r);
-    l.send(stop, s.steps);
+    l.send(stop, steps);
     proto::Text report{proto::Tag::final_report, {}};
     l.recv(report);
     auto part = nlohmann::json::parse(report.text);
@@ -301,8 +316,9 @@ void Coupler::finish() {
   }
   const double loop = std::max(m_rt.wall_seconds() - m_t_start, kMinLoopSeconds);
   j["wall_time"]["coupler"] = m_rt.wall_seconds();
-  j["coupler"]["steps_per_second"] = s.steps / loop;
-  j["coupler"]["us_per_step"] = 1e6 * loop / s.steps;
+  const double computed = std::max<long>(steps - first, 1);
+  j["coupler"]["steps_per_second"] = computed / loop;
+  j["coupler"]["us_per_step"] = 1e6 * loop / computed;
   j["coupler"]["phases"] = nlohmann::json::parse(m_phases.to_json().dump());
   if (m_accel) {
     j["coupler"]["iterations"] = {
@@ -311,13 +327,13 @@ void Coupler::finish() {
         {"relaxation", m_iter.relaxation},
         {"reuse", m_iter.reuse},
         {"total", m_iter_total},
-        {"mean_per_step", s.steps > 0 ? double(m_iter_total) / double(s.steps) : 0.0},
+        {"mean_per_step", steps > 0 ? double(m_iter_total) / double(steps) : 0.0},
         {"max_per_step", m_iter_max},
         {"not_converged_steps", m_not_converged},
         {"largest_final_residual", m_residual_max}};
   }
   fsi::write_summary(m_rt, j);
-  m_progress->finish(s.steps, fsi::step_time(s, s.steps),
+  m_progress->finish(steps, fsi::step_time(s, steps),
                      fmt::format("output in {}", m_rt.out_dir().string()));
 }
 

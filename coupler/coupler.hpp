@@ -51,7 +51,11 @@ class Coupler {
   void commit(long n);
   void fibers(long n);
   void report(long n);
-  void finish();
+  // The end of the run after `steps` steps (computed from step `first` on).
+  void finish(long steps, long first);
+  // Checkpoint and restart (checkpoint.cpp): what the next step reads beyond the solvers' states.
+  void save(fsi::H5File& h5) const;
+  void load(const fsi::H5File& h5);
   bool has(fsi::Role r) const { return m_rt.roles()[r]; }
   bool iterates() const { return m_accel && m_immersed; }
   // The state the footprint is taken from: x^n with v^n (explicit step) or with the current
@@ -158,6 +162,7 @@ class Coupler {
   long m_iter_total = 0, m_iter_max = 0, m_not_converged = 0;
   double m_residual_max = 0;
   std::unique_ptr<fsi::ProbeCsv> m_iter_csv;
+  bool m_stopping = false;  // asked to stop: the step under way is checkpointed and is the last
 };
 
 }  // namespace coupler

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "checkpoint.hpp"
 #include "coupler.hpp"
 #include "driver.hpp"
 
@@ -48,7 +49,8 @@ void Coupler::setup_force_probes() {
     std::vector<std::string> cols;
     for (const auto& g : m_force_groups)
       cols.push_back(g.name + ".fx"), cols.push_back(g.name + ".fy");
-    m_probes = std::make_unique<fsi::ProbeCsv>(m_rt.out_dir() / "coupler_forces.csv", cols);
+    m_probes = std::make_unique<fsi::ProbeCsv>(
+        fsi::output_csv(m_rt, m_rt.out_dir() / "coupler_forces.csv", cols));
     m_probe_row.assign(cols.size(), 0.0);
   }
   m_momentum.resize(bodies.size());

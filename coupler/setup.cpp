@@ -4,6 +4,7 @@
 #include <sstream>
 #include <toml.hpp>
 
+#include "checkpoint.hpp"
 #include "coupler.hpp"
 
 namespace coupler {
@@ -135,10 +136,15 @@ void Coupler::setup() {
   if (m_ib) warn_marker_spacing();
   setup_force_probes();
   if (m_accel)
-    m_iter_csv = std::make_unique<fsi::ProbeCsv>(
-        m_rt.out_dir() / "coupler_iterations.csv",
+    m_iter_csv = std::make_unique<fsi::ProbeCsv>(fsi::output_csv(
+        m_rt, m_rt.out_dir() / "coupler_iterations.csv",
         std::vector<std::string>{"step", "iterations", "residual_first", "residual", "converged",
-                                 "omega", "columns"});
+                                 "omega", "columns"}));
+  if ((m_log_csv || m_dump_every > 0) && m_rt.restart_step())
+    throw fsi::InputError(fmt::format(
+        "coupler.diagnostics: the exchange log cannot continue a restarted run; turn exchange "
+        "and dump_every off for the restart (in {})",
+        m_rt.scene().file().string()));
   if (m_log_csv || m_dump_every > 0)
     m_log = std::make_unique<ExchangeLog>(m_rt.out_dir(), m_grid, m_meshes, m_layout,
                                           m_rt.settings().dt, m_log_csv, m_dump_every);

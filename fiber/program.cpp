@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "checkpoint.hpp"
+
 namespace fiber {
 
 namespace {
@@ -24,7 +26,7 @@ Config read_checked(fsi::Runtime& rt) {
 }  // namespace
 
 FiberProgram::FiberProgram(fsi::Runtime& rt)
-    : m_rt(rt), m_h5(rt.out_dir() / "fiber.h5", fsi::H5File::Mode::truncate) {
+    : m_rt(rt), m_h5(fsi::output_h5(rt, rt.out_dir() / "fiber.h5")) {
   m_system.emplace(read_checked(rt));
   const FiberSystem& sys = *m_system;
   const Config& cfg = sys.config();
@@ -48,11 +50,13 @@ FiberProgram::FiberProgram(fsi::Runtime& rt)
   m_h5.set_attribute("layout", "names", names);
   m_xdmf.emplace(rt.out_dir() / "fiber.xdmf", rt.out_dir() / "fiber.h5",
                  fsi::XdmfPolylines{"/layout/segments", seg.size() / 2, sys.total_markers()}, "fibers");
+  if (rt.restart_step()) m_xdmf->resume(fsi::restart_fields_time(rt));
 
   if (!cfg.probes.empty()) {
     std::vector<std::string> pn;
     for (const auto& p : cfg.probes) pn.push_back(p.name);
-    m_probes.emplace(rt.out_dir() / "fiber_probes.csv", fsi::probe_columns(pn, {"x", "y", "tension", "curvature"}));
+    m_probes.emplace(fsi::output_csv(rt, rt.out_dir() / "fiber_probes.csv",
+                                     fsi::probe_columns(pn, {"x", "y", "tension", "curvature"})));
   }
   // Loads on supports: one column group per supported end.
   std::vector<std::string> ln;
@@ -67,7 +71,9 @@ FiberProgram::FiberProgram(fsi::Runtime& rt)
       ln.push_back(f.name + "_tip");
     }
   }
-  if (!ln.empty()) m_loads.emplace(rt.out_dir() / "fiber_loads.csv", fsi::probe_columns(ln, {"fx", "fy", "moment"}));
+  if (!ln.empty())
+    m_loads.emplace(fsi::output_csv(rt, rt.out_dir() / "fiber_loads.csv",
+                                    fsi::probe_columns(ln, {"fx", "fy", "moment"})));
   m_ext.assign(2 * sys.total_markers(), 0.0);
   m_poses.resize(sys.fiber_count());
 }
@@ -97,6 +103,7 @@ fsi::proto::FiberLayout FiberProgram::layout() const {
 }
 
 void FiberProgram::set_initial_roots(const std::vector<std::vector<double>>& root_pose) {
+  if (m_rt.restart_step()) return;  // the roots are where the checkpoint has them
   FiberSystem& sys = *m_system;
   for (int k = 0; k < sys.fiber_count() && k < static_cast<int>(root_pose.size()); ++k) {
     if (sys.root_kind(k) != EndKind::attached) continue;

@@ -25,6 +25,8 @@ class FiberProgram : public fsi::FiberPort {
   void output(long step, double t, bool fields) override;
   std::string status() const override;
   nlohmann::json report() const override;
+  void save(fsi::H5File& h5) const override { m_system->save(h5); }
+  void load(const fsi::H5File& h5) override { m_system->load(h5); }
 
   const FiberSystem& system() const { return *m_system; }
 

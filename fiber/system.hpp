@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cell_list.hpp"
+#include "h5.hpp"
 #include "spec.hpp"
 
 namespace fiber {
@@ -109,6 +110,10 @@ class FiberSystem {
   double kinetic_energy(int k) const;
   const PhaseTimes& phase_times() const { return m_times; }
   void reset_phase_times() { m_times = PhaseTimes{}; }
+  // Checkpoints (checkpoint.cpp), between steps: positions X^n, X^(n-1) and the sub-steps' own
+  // history, tensions (the next tension solve starts from them), root poses and loads, clock.
+  void save(fsi::H5File& h5) const;
+  void load(const fsi::H5File& h5);
 
  private:
   struct Fiber {

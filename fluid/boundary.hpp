@@ -5,11 +5,13 @@
 #pragma once
 
 #include <array>
+#include <string>
 #include <vector>
 
 #include "config.hpp"
 #include "field.hpp"
 #include "grid.hpp"
+#include "h5.hpp"
 
 namespace fluid {
 
@@ -40,6 +42,10 @@ class Boundaries {
   void fill_scalar(Field& p) const;
   // Net volume flux into the domain through its boundary (per unit depth).
   double net_inflow(const Field& u, const Field& v) const;
+  // What advance_normal() carries from step to step (the outflows' last interior lines, the
+  // walls' speeds), for checkpoints: saved into and loaded from group `group`.
+  void save(fsi::H5File& h5, const std::string& group) const;
+  void load(const fsi::H5File& h5, const std::string& group);
 
  private:
   const Grid& m_g;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "checkpoint.hpp"
 #include "diagnostics.hpp"
 
 namespace fluid {
@@ -15,7 +16,7 @@ FluidProgram::FluidProgram(fsi::Runtime& rt)
     : m_rt(rt),
       m_cfg(read_config(rt.root().table("fluid"), rt.settings().dt)),
       m_solver(std::make_unique<Solver>(m_cfg, rt.settings().dt)),
-      m_h5(rt.out_dir() / "fluid.h5", fsi::H5File::Mode::truncate) {
+      m_h5(fsi::output_h5(rt, rt.out_dir() / "fluid.h5")) {
   set_initial(*m_solver);
   const Grid& g = m_solver->grid();
   std::vector<double> xf(g.nx() + 1), yf(g.ny() + 1);
@@ -35,11 +36,12 @@ FluidProgram::FluidProgram(fsi::Runtime& rt)
   m_xdmf.emplace(rt.out_dir() / "fluid.xdmf", rt.out_dir() / "fluid.h5",
                  fsi::XdmfStructured{"/grid/nodes", xf.size(), yf.size()},
                  "fluid");
+  if (rt.restart_step()) m_xdmf->resume(fsi::restart_fields_time(rt));
   if (!m_cfg.probes.empty()) {
     std::vector<std::string> names;
     for (const Probe& p : m_cfg.probes) names.push_back(p.name);
-    m_probes.emplace(rt.out_dir() / "fluid_probes.csv",
-                     fsi::probe_columns(names, {"ux", "uy", "p"}));
+    m_probes.emplace(fsi::output_csv(rt, rt.out_dir() / "fluid_probes.csv",
+                                     fsi::probe_columns(names, {"ux", "uy", "p"})));
     m_row.resize(3 * names.size());
   }
 }
@@ -176,6 +178,18 @@ void FluidProgram::output(long step, double t, bool fields) {
     m_probes->write(t, m_row);
   }
   if (fields) write_fields(step, t);
+}
+
+// The solver's state, and the health check's (the diagnostics the coupler is sent).
+void FluidProgram::save(fsi::H5File& h5) const {
+  m_solver->save(h5);
+  h5.write("health", std::vector<double>{m_cfl, m_div, m_div_first, m_energy});
+}
+
+void FluidProgram::load(const fsi::H5File& h5) {
+  m_solver->load(h5);
+  const auto h = h5.read_doubles("health");
+  m_cfl = h.at(0), m_div = h.at(1), m_div_first = h.at(2), m_energy = h.at(3);
 }
 
 std::string FluidProgram::status() const {

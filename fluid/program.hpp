@@ -25,6 +25,8 @@ class FluidProgram : public fsi::FluidPort {
   void output(long step, double t, bool fields) override;
   std::string status() const override;
   nlohmann::json report() const override;
+  void save(fsi::H5File& h5) const override;
+  void load(const fsi::H5File& h5) override;
 
  private:
   void write_fields(long step, double t);

@@ -99,6 +99,10 @@ class Solver {
   const Field& p() const { return m_p; }
   // Make the current velocity discretely divergence-free (boundary values at the current time).
   void project_initial();
+  // Checkpoints (checkpoint.cpp): the state a step starts from, between steps: u, v, p with their
+  // ghosts, the last step's explicit terms H^n (AB2), its dt, the clock, the boundaries' state.
+  void save(fsi::H5File& h5) const;
+  void load(const fsi::H5File& h5);
 
   // First active u column (0 if x periodic, else 1) and v row.
   int i0() const { return m_i0; }

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "checkpoint.hpp"
 #include "coupling.hpp"
 
 namespace solid {
@@ -29,7 +30,7 @@ std::string body_group(const std::string& name) {
 SolidProgram::SolidProgram(fsi::Runtime& rt)
     : m_rt(rt),
       m_cfg(read_config(rt.root().table("solid"), fluid_density_of(rt))),
-      m_h5(rt.out_dir() / "solid.h5", fsi::H5File::Mode::truncate) {
+      m_h5(fsi::output_h5(rt, rt.out_dir() / "solid.h5")) {
   m_solver = std::make_unique<Solver>(m_cfg.model);
   const Solver& s = *m_solver;
   for (int b = 0; b < s.num_bodies(); ++b) {
@@ -49,6 +50,7 @@ SolidProgram::SolidProgram(fsi::Runtime& rt)
         rt.out_dir() / "solid.h5",
         fsi::XdmfTriangles{g + "/triangles", m.triangles.size(), std::size_t(m.num_nodes())},
         m_cfg.model.bodies[b].name);
+    if (rt.restart_step()) m_xdmf.back().resume(fsi::restart_fields_time(rt));
     if (m_cfg.quality[b].min_quality < 0.1)
       fmt::print(
           stderr,
@@ -74,8 +76,8 @@ SolidProgram::SolidProgram(fsi::Runtime& rt)
       names.push_back(p.name);
       m_probe_points.push_back(locate(s.mesh(p.body), p.point[0], p.point[1], kProbeLocateTolerance));
     }
-    m_probes.emplace(rt.out_dir() / "solid_probes.csv",
-                     fsi::probe_columns(names, {"x", "y", "ux", "uy", "vx", "vy"}));
+    m_probes.emplace(fsi::output_csv(rt, rt.out_dir() / "solid_probes.csv",
+                                     fsi::probe_columns(names, {"x", "y", "ux", "uy", "vx", "vy"})));
   }
   std::vector<std::string> cols{"kinetic",        "strain",  "load_potential",
                                 "total_energy",   "min_gap", "newton_iterations",
@@ -84,7 +86,7 @@ SolidProgram::SolidProgram(fsi::Runtime& rt)
     cols.push_back(b.name + ".contact_fx");
     cols.push_back(b.name + ".contact_fy");
   }
-  m_history.emplace(rt.out_dir() / "solid_history.csv", cols);
+  m_history.emplace(fsi::output_csv(rt, rt.out_dir() / "solid_history.csv", cols));
   m_external.resize(s.num_bodies());
 }
 

@@ -29,6 +29,8 @@ class SolidProgram : public fsi::SolidPort {
   void output(long step, double t, bool fields) override;
   std::string status() const override;
   nlohmann::json report() const override;
+  void save(fsi::H5File& h5) const override;  // checkpoint.cpp
+  void load(const fsi::H5File& h5) override;
 
  private:
   void write_modes();

@@ -1,0 +1,76 @@
+// The solid's part of a checkpoint: the Newmark state of every body (u, v, M a, positions), the
+// contact slots with their active set and multipliers, the clock, and the run's counters.
+#include "checkpoint.hpp"
+
+#include "program.hpp"
+
+namespace solid {
+
+namespace {
+
+// One contact slot as numbers: the pair, the last detection (gap, feature, normal) and the
+// active-set state.
+constexpr std::size_t kSlotValues = 12;
+
+std::vector<double> slots_to_numbers(const std::vector<ContactSlot>& slots) {
+  std::vector<double> a;
+  for (const ContactSlot& c : slots)
+    a.insert(a.end(), {double(c.slave_body), double(c.slave_node), double(c.master_body),
+                       double(c.plane), c.gap, double(c.m0), double(c.m1), c.xi, c.normal[0],
+                       c.normal[1], c.active ? 1.0 : 0.0, c.lambda});
+  return a;
+}
+
+std::vector<ContactSlot> numbers_to_slots(const std::vector<double>& a, const fsi::H5File& h5) {
+  if (a.size() % kSlotValues != 0) fsi::fail("checkpoint {}: the contact slots are damaged", h5.path().string());
+  std::vector<ContactSlot> slots(a.size() / kSlotValues);
+  for (std::size_t k = 0; k < slots.size(); ++k) {
+    const double* v = &a[kSlotValues * k];
+    ContactSlot& c = slots[k];
+    c.slave_body = int(v[0]), c.slave_node = int(v[1]), c.master_body = int(v[2]), c.plane = int(v[3]);
+    c.gap = v[4], c.m0 = int(v[5]), c.m1 = int(v[6]), c.xi = v[7], c.normal = Vec2{v[8], v[9]};
+    c.active = v[10] != 0, c.lambda = v[11];
+  }
+  return slots;
+}
+
+}  // namespace
+
+void SolidProgram::save(fsi::H5File& h5) const {
+  StepState s;
+  m_solver->save_state(s);
+  fsi::write_vectors(h5, "solid/u", s.u);
+  fsi::write_vectors(h5, "solid/v", s.v);
+  fsi::write_vectors(h5, "solid/ma", s.ma);
+  fsi::write_vectors(h5, "solid/x", s.x);
+  fsi::write_vectors(h5, "solid/contact", s.contact);
+  h5.write("solid/slots", slots_to_numbers(s.slots));
+  h5.write("solid/clock", std::vector<double>{s.time, s.contact_force_factor});
+  h5.write("solid/counts", std::vector<std::int64_t>{s.step, m_steps, m_repeats, m_newton_total, m_newton_max});
+  h5.write("solid/t_end", std::vector<double>{m_rt.settings().t_end});
+}
+
+void SolidProgram::load(const fsi::H5File& h5) {
+  // A static analysis walks the load factor t / t_end: another t_end would be another problem.
+  const double t_end = h5.read_doubles("solid/t_end").at(0);
+  if (m_cfg.model.settings.analysis == Analysis::statics && t_end != m_rt.settings().t_end)
+    throw fsi::InputError(fmt::format(
+        "time.t_end = {:g} differs from the {:g} of the static analysis being resumed (its load "
+        "factor is t / t_end); keep t_end (in {})",
+        m_rt.settings().t_end, t_end, m_rt.scene().file().string()));
+  StepState s;
+  s.u = fsi::read_vectors(h5, "solid/u");
+  s.v = fsi::read_vectors(h5, "solid/v");
+  s.ma = fsi::read_vectors(h5, "solid/ma");
+  s.x = fsi::read_vectors(h5, "solid/x");
+  s.contact = fsi::read_vectors(h5, "solid/contact");
+  s.slots = numbers_to_slots(h5.read_doubles("solid/slots"), h5);
+  const auto clock = h5.read_doubles("solid/clock");
+  s.time = clock.at(0), s.contact_force_factor = clock.at(1);
+  const auto counts = h5.read_int64s("solid/counts");
+  s.step = counts.at(0), m_steps = counts.at(1), m_repeats = counts.at(2);
+  m_newton_total = counts.at(3), m_newton_max = counts.at(4);
+  m_solver->restore_state(s);
+}
+
+}  // namespace solid
