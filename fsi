@@ -123,14 +123,24 @@ run() {
   scene=$(cd "$(dirname "$scene")" && pwd)/$(basename "$scene")
   build
   plan "$scene"
-  # Never overwrite silently: out/NAME, else out/NAME-2, -3, ...
-  local dir=$ROOT/out/$NAME n=2
+  # Never overwrite silently: out/NAME, else out/NAME-2, -3, ... Each is taken by one mkdir, so
+  # two runs started together get two folders (the programs lock theirs: DIR/.lock).
+  # FSI_OUT_ROOT (tests): another folder than out/ to hold the output folders.
+  local outs=${FSI_OUT_ROOT:-$ROOT/out}
+  local dir=$outs/$NAME n=2
+  mkdir -p "$outs"
   if [ ${#overwrite[@]} -eq 0 ]; then
-    while [ -e "$dir" ]; do dir=$ROOT/out/$NAME-$n; n=$((n + 1)); done
+    until mkdir "$dir" 2>/dev/null; do
+      [ -e "$dir" ] || die "cannot create the output folder ${dir#$ROOT/}"
+      dir=$outs/$NAME-$n
+      n=$((n + 1))
+    done
   fi
   compose "$scene" --out-dir "$dir" "${overwrite[@]}"
   say "running: ${CMD[*]}"
-  "${CMD[@]}"
+  local rc=0
+  launch "${CMD[@]}" || rc=$?
+  [ $rc -eq 0 ] || exit $rc
   # Post-processing: the scene's own plot script if its folder has one, else the generic one.
   local plot=$(dirname "$scene")/plot.py
   [ -x "$plot" ] || plot=$ROOT/runs/plot_run.py
@@ -138,6 +148,68 @@ run() {
   say "output in ${dir#$ROOT/}/"
   ls "$dir"/*.png >/dev/null 2>&1 && say "picture: $(ls "$dir"/*.png | head -1 | sed "s|$ROOT/||")"
   return 0
+}
+
+# Open MPI's lines after every MPI_Abort that tell nothing of the cause (its bookkeeping of the
+# processes it killed) and mislead; every other line of mpirun's stays visible.
+MPI_NOISE='ORTE_ERROR_LOG: (Out of resource|Data unpack would read past end of buffer)'
+
+# launch MPIRUN ARGS...: run the job, stderr filtered of MPI_NOISE (the programs' "[role] ERROR:"
+# lines kept aside for the summary), and wait for it. SIGTERM, SIGINT or SIGHUP to the launcher
+# is passed to mpirun as SIGTERM (mpirun then ends its programs), SIGKILL 8 s later if it has not
+# ended. The programs watch this process (FSI_LAUNCHER_PID): when it is killed outright (SIGKILL)
+# they end themselves within a second. Returns mpirun's exit code, or 128 + the signal's number;
+# after a failure it names the program(s) that reported an error.
+launch() {
+  local tmp errs fifo pid fpid sig= rc
+  tmp=$(mktemp -d)
+  errs=$tmp/errors fifo=$tmp/stderr
+  : >"$errs"
+  mkfifo "$fifo"
+  awk -v errs="$errs" -v noise="$MPI_NOISE" '
+    $0 ~ noise { next }
+    /^\[(fluid|solid|fiber|coupler)\] ERROR: / { print >> errs; fflush(errs) }
+    { print; fflush() }' <"$fifo" >&2 &
+  fpid=$!
+  FSI_LAUNCHER_PID=$$ "$@" 2>"$fifo" &
+  pid=$!
+  forward() {
+    sig=$1
+    say "SIG$1: ending the job"
+    kill -TERM "$pid" 2>/dev/null || true
+    (sleep 8; kill -KILL "$pid" 2>/dev/null) &
+  }
+  trap 'forward TERM' TERM
+  trap 'forward INT' INT
+  trap 'forward HUP' HUP
+  while :; do
+    rc=0
+    wait "$pid" || rc=$?
+    # A trapped signal ends the wait early: wait again while mpirun ends its programs.
+    if [ $rc -gt 128 ] && kill -0 "$pid" 2>/dev/null; then continue; fi
+    break
+  done
+  trap - TERM INT HUP
+  wait "$fpid" 2>/dev/null || true
+  if [ -n "$sig" ]; then
+    rm -rf "$tmp"
+    say "job ended on SIG$sig"
+    return $((128 + $(kill -l "$sig")))
+  fi
+  if [ $rc -ne 0 ]; then
+    local ranks="" k=0 r
+    for r in $ROLES; do ranks+="${ranks:+, }$k = $r"; k=$((k + 1)); done
+    if [ -s "$errs" ]; then
+      local who
+      who=$(sed -n 's/^\[\([a-z]*\)\] ERROR: .*/\1/p' "$errs" | awk '!seen[$0]++' | paste -sd, - | sed 's/,/, /g')
+      say "job failed (mpirun exit code $rc): the error came from: $who"
+      sed -n '1s/^/[fsi]   first error: /p' "$errs" >&2
+    else
+      say "job failed (mpirun exit code $rc) without a program's ERROR line: a program crashed or was killed (Open MPI's lines above name it by rank; the ranks: $ranks)"
+    fi
+  fi
+  rm -rf "$tmp"
+  return $rc
 }
 
 test_suite() {
