@@ -23,6 +23,8 @@ usage: ./fsi COMMAND [ARGS]
 
   run [SCENE] [--overwrite]   build, then run SCENE (default: runs/default/scene.toml) as one
                               mpirun job of the programs it needs; output in out/<scene name>/
+      [--time-limit SECONDS]  checkpoint and stop after this wall time
+      [--restart OUTDIR]      resume the run in OUTDIR from its newest complete checkpoint
   test [CTEST ARGS]           build, then run the whole test suite through CTest
   test --debug [CTEST ARGS]   the same in a Debug build (build-debug/: internal assertions and
                               bounds-checked field access on); unit and integration tests
@@ -112,10 +114,14 @@ compose() {
 }
 
 run() {
-  local scene=$DEFAULT_SCENE overwrite=()
+  local scene=$DEFAULT_SCENE overwrite=() restart= limit=()
   while [ $# -gt 0 ]; do
     case "$1" in
       --overwrite) overwrite=(--overwrite) ;;
+      --restart) [ $# -ge 2 ] || die "--restart needs the output folder of the run to resume"
+                 restart=$2; shift ;;
+      --time-limit) [ $# -ge 2 ] || die "--time-limit needs a number of seconds"
+                    limit=(--time-limit "$2"); shift ;;
       -*) die "unknown option '$1' for run (see ./fsi help)" ;;
       *) scene=$1 ;;
     esac
@@ -123,16 +129,37 @@ run() {
   done
   [ -f "$scene" ] || die "scene file '$scene' does not exist"
   scene=$(cd "$(dirname "$scene")" && pwd)/$(basename "$scene")
+  [ -z "$restart" ] || [ ${#overwrite[@]} -eq 0 ] || die "--restart resumes in its folder: no --overwrite"
   build
   plan "$scene"
-  # Never overwrite silently: out/NAME, else out/NAME-2, -3, ...
-  local dir=$ROOT/out/$NAME n=2
-  if [ ${#overwrite[@]} -eq 0 ]; then
-    while [ -e "$dir" ]; do dir=$ROOT/out/$NAME-$n; n=$((n + 1)); done
+  # Never overwrite silently: out/NAME, else out/NAME-2, -3, ... Each is taken by one mkdir, so
+  # two runs started together get two folders (the programs lock theirs: DIR/.lock).
+  # FSI_OUT_ROOT (tests): another folder than out/ to hold the output folders.
+  local outs=${FSI_OUT_ROOT:-$ROOT/out}
+  local dir=$outs/$NAME n=2
+  if [ -n "$restart" ]; then
+    # Resume in the run's own folder, from its newest complete checkpoint.
+    [ -d "$restart/checkpoint" ] || die "--restart $restart: no checkpoint folder in it"
+    dir=$(cd "$restart" && pwd)
+    compose "$scene" --restart "$dir" "${limit[@]}"
+  else
+    mkdir -p "$outs"
+    if [ ${#overwrite[@]} -eq 0 ]; then
+      until mkdir "$dir" 2>/dev/null; do
+        [ -e "$dir" ] || die "cannot create the output folder ${dir#$ROOT/}"
+        dir=$outs/$NAME-$n
+        n=$((n + 1))
+      done
+    fi
+    compose "$scene" --out-dir "$dir" "${overwrite[@]}" "${limit[@]}"
   fi
-  compose "$scene" --out-dir "$dir" "${overwrite[@]}"
   say "running: ${CMD[*]}"
-  "${CMD[@]}"
+  local rc=0
+  launch "${CMD[@]}" || rc=$?
+  if [ -n "$(ls -d "$dir"/checkpoint/step_* 2>/dev/null)" ] && { [ $rc -gt 128 ] || grep -q '"stopped_at_step"' "$dir/summary.json" 2>/dev/null; }; then
+    say "stopped with a checkpoint; resume with: ./fsi run ${scene#$ROOT/} --restart ${dir#$ROOT/}"
+  fi
+  [ $rc -eq 0 ] || exit $rc
   [ -d "$dir" ] || die "the output folder ${dir#$ROOT/}/ is gone (deleted during the run?)"
   # Post-processing: the scene's own plot script if its folder has one, else the generic one.
   local plot=$(dirname "$scene")/plot.py
@@ -141,6 +168,71 @@ run() {
   say "output in ${dir#$ROOT/}/"
   ls "$dir"/*.png >/dev/null 2>&1 && say "picture: $(ls -U "$dir"/picture.png "$dir"/*.png 2>/dev/null | head -1 | sed "s|$ROOT/||")"
   return 0
+}
+
+# Open MPI's lines after every MPI_Abort that tell nothing of the cause (its bookkeeping of the
+# processes it killed) and mislead; every other line of mpirun's stays visible.
+MPI_NOISE='ORTE_ERROR_LOG: (Out of resource|Data unpack would read past end of buffer)'
+
+# launch MPIRUN ARGS...: run the job, stderr filtered of MPI_NOISE (the programs' "[role] ERROR:"
+# lines kept aside for the summary), and wait for it. SIGTERM, SIGINT or SIGHUP to the launcher
+# is passed to mpirun as SIGUSR1, which mpirun forwards to its programs: the run checkpoints the
+# step under way and stops (README, "Stopping and resuming"); SIGTERM follows 5 s later and
+# SIGKILL 8 s later if it has not ended. The programs watch this process (FSI_LAUNCHER_PID): when it is killed outright (SIGKILL)
+# they end themselves within a second. Returns mpirun's exit code, or 128 + the signal's number;
+# after a failure it names the program(s) that reported an error.
+launch() {
+  local tmp errs fifo pid fpid sig= rc kpid=
+  tmp=$(mktemp -d)
+  errs=$tmp/errors fifo=$tmp/stderr
+  : >"$errs"
+  mkfifo "$fifo"
+  awk -v errs="$errs" -v noise="$MPI_NOISE" '
+    $0 ~ noise { next }
+    /^\[(fluid|solid|fiber|coupler)\] ERROR: / { print >> errs; fflush(errs) }
+    { print; fflush() }' <"$fifo" >&2 &
+  fpid=$!
+  FSI_LAUNCHER_PID=$$ "$@" 2>"$fifo" &
+  pid=$!
+  forward() {
+    sig=$1
+    say "SIG$1: checkpointing and ending the job"
+    kill -USR1 "$pid" 2>/dev/null || true
+    (sleep 5; kill -TERM "$pid" 2>/dev/null; sleep 3; kill -KILL "$pid" 2>/dev/null) &
+    kpid=$!
+  }
+  trap 'forward TERM' TERM
+  trap 'forward INT' INT
+  trap 'forward HUP' HUP
+  while :; do
+    rc=0
+    wait "$pid" || rc=$?
+    # A trapped signal ends the wait early: wait again while mpirun ends its programs.
+    if [ $rc -gt 128 ] && kill -0 "$pid" 2>/dev/null; then continue; fi
+    break
+  done
+  trap - TERM INT HUP
+  [ -z "$kpid" ] || kill "$kpid" 2>/dev/null || true
+  wait "$fpid" 2>/dev/null || true
+  if [ -n "$sig" ]; then
+    rm -rf "$tmp"
+    say "job ended on SIG$sig"
+    return $((128 + $(kill -l "$sig")))
+  fi
+  if [ $rc -ne 0 ]; then
+    local ranks="" k=0 r
+    for r in $ROLES; do ranks+="${ranks:+, }$k = $r"; k=$((k + 1)); done
+    if [ -s "$errs" ]; then
+      local who
+      who=$(sed -n 's/^\[\([a-z]*\)\] ERROR: .*/\1/p' "$errs" | awk '!seen[$0]++' | paste -sd, - | sed 's/,/, /g')
+      say "job failed (mpirun exit code $rc): the error came from: $who"
+      sed -n '1s/^/[fsi]   first error: /p' "$errs" >&2
+    else
+      say "job failed (mpirun exit code $rc) without a program's ERROR line: a program crashed or was killed (Open MPI's lines above name it by rank; the ranks: $ranks)"
+    fi
+  fi
+  rm -rf "$tmp"
+  return $rc
 }
 
 test_suite() {

@@ -3,6 +3,10 @@
 // fsi::Error instead.
 #include "h5.hpp"
 
+#include <sys/statvfs.h>
+
+#include <cerrno>
+
 #include <hdf5.h>
 
 #include <algorithm>
@@ -134,7 +138,8 @@ H5File::H5File(const std::filesystem::path& path, Mode mode) : m_path(path) {
 H5File::~H5File() { close(); }
 
 H5File::H5File(H5File&& other) noexcept
-    : m_path(std::move(other.m_path)), m_id(other.m_id), m_is_writable(other.m_is_writable) {
+    : m_path(std::move(other.m_path)), m_id(other.m_id), m_is_writable(other.m_is_writable),
+      m_failed(other.m_failed) {
   other.m_id = -1;
 }
 
@@ -144,6 +149,7 @@ H5File& H5File::operator=(H5File&& other) noexcept {
     m_path = std::move(other.m_path);
     m_id = other.m_id;
     m_is_writable = other.m_is_writable;
+    m_failed = other.m_failed;
     other.m_id = -1;
   }
   return *this;
@@ -151,19 +157,60 @@ H5File& H5File::operator=(H5File&& other) noexcept {
 
 void H5File::close() noexcept {
   if (m_id >= 0) {
+    // After a failed write the handle is left open, unflushed: closing would write the metadata
+    // of the half-written step over the file's last consistent state.
+    if (m_failed && m_is_writable) {
+      m_id = -1;
+      return;
+    }
     if (m_is_writable) H5Fflush(m_id, H5F_SCOPE_GLOBAL);
     H5Fclose(m_id);
     m_id = -1;
   }
 }
 
+namespace {
+
+// Free bytes of the file system holding `file` (for a process that is not root); -1 unknown.
+double free_bytes(const std::filesystem::path& file) {
+  struct statvfs v;
+  std::filesystem::path dir = file.parent_path();
+  if (dir.empty()) dir = ".";
+  if (::statvfs(dir.c_str(), &v) != 0) return -1;
+  return static_cast<double>(v.f_bavail) * static_cast<double>(v.f_frsize);
+}
+
+// HDF5's own records beside the data of one write (object headers, B-tree nodes, the heap).
+constexpr double kMetadataMargin = 64 * 1024;
+
+}  // namespace
+
+void H5File::ensure_space(std::size_t bytes, std::string_view object) const {
+  const double have = free_bytes(m_path);
+  if (have >= 0 && have < static_cast<double>(bytes) + kMetadataMargin) {
+    m_failed = true;
+    throw Error(fmt::format(
+        "HDF5: no space left on device: writing '{}' ({} bytes) to {} needs about {:.0f} bytes, "
+        "{:.0f} are free; the file holds every step written before this one",
+        object_name(object), bytes, m_path.string(), bytes + kMetadataMargin, have));
+  }
+}
+
 void H5File::raise(const std::string& what, std::string_view object) const {
+  const int err = errno;
   std::string detail = hdf5_message();
   std::string where = object.empty() ? m_path.string() : fmt::format("'{}' in {}", object, m_path.string());
+  if (m_is_writable) m_failed = true;
+  const double have = m_is_writable ? free_bytes(m_path) : -1;
+  if (m_is_writable && (err == ENOSPC || (have >= 0 && have < kMetadataMargin)))
+    throw Error(fmt::format("HDF5: no space left on device: {} {}; the file holds every step "
+                            "written before this one{}",
+                            what, where, detail.empty() ? "" : " (" + detail + ")"));
   throw Error(fmt::format("HDF5: {} {}{}", what, where, detail.empty() ? "" : " (" + detail + ")"));
 }
 
 void H5File::flush() {
+  if (m_failed) return;
   if (H5Fflush(m_id, H5F_SCOPE_GLOBAL) < 0) raise("cannot flush", "");
 }
 
@@ -219,6 +266,7 @@ void H5File::write_typed(std::string_view name, std::span<const T> data, const H
   if (product(shape) != data.size())
     throw Error(fmt::format("HDF5: dataset '{}' in {}: shape {} does not hold {} values", path,
                             m_path.string(), shape_text(shape), data.size()));
+  ensure_space(data.size() * sizeof(T), path);
   std::vector<hsize_t> dims = to_hsize(shape);
   Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose);
 
@@ -267,6 +315,7 @@ void H5File::write(std::string_view name, std::span<const std::int64_t> data, co
 void H5File::write_window(std::string_view name, std::span<const double> data, const H5Shape& full,
                           const H5Shape& offset, const H5Shape& count) {
   std::string path = object_name(name);
+  if (count.size() == 2) ensure_space(count[0] * count[1] * sizeof(double), path);
   if (full.size() != 2 || offset.size() != 2 || count.size() != 2)
     throw Error(fmt::format("HDF5: dataset '{}' in {}: write_window takes 2D shapes", path,
                             m_path.string()));
@@ -413,6 +462,7 @@ void H5File::create_series(std::string_view name, std::size_t width) {
 
 void H5File::append(std::string_view name, std::span<const double> row) {
   std::string path = object_name(name);
+  ensure_space(row.size() * sizeof(double), path);
   Handle set(H5Dopen2(m_id, path.c_str(), H5P_DEFAULT), H5Dclose);
   if (!set.ok()) raise("no series (create_series first)", path);
   Handle space(H5Dget_space(set.get()), H5Sclose);

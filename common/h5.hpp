@@ -110,6 +110,12 @@ class H5File {
   std::filesystem::path m_path;
   std::int64_t m_id = -1;  // hid_t of the open file
   bool m_is_writable = false;
+  // A write failed (disk full, I/O error): the file is not flushed or closed again, so that what
+  // is on disk stays the file as of its last complete flush (every earlier step readable).
+  mutable bool m_failed = false;
+  // Before writing `bytes`: fails with "no space left on device" when the file system cannot
+  // take them (and a margin for HDF5's own records), before anything of the write is done.
+  void ensure_space(std::size_t bytes, std::string_view object) const;
 };
 
 }  // namespace fsi

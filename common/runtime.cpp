@@ -1,12 +1,20 @@
 // MPMD start-up, handshake, links and the error funnel (see runtime.hpp).
 #include "runtime.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <cerrno>
+#include <chrono>
 #include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
 #include <thread>
 
 #include "checkpoint.hpp"
@@ -41,6 +49,32 @@ constexpr int kLinkTagBase = 7100;
 // t_end / dt within this relative distance of an integer is that many steps (round-off of the
 // division); further away, the step count rounds up.
 constexpr double kStepCountTolerance = 1e-9;
+// The most steps a run may have: 2^53, the last integer a double counts exactly.
+constexpr double kMaxSteps = 9007199254740992.0;
+
+// How long a program waits for a message before it calls its peer stalled (runtime.hpp,
+// output.stall_timeout): a fixed limit when the scene gives one (> 0), else automatic.
+double g_stall_fixed = 0;
+// Automatic: no message waited for longer than kStallFactor times the longest wait that ended so
+// far (which holds the peers' longest step), and never less than kStallFloor seconds; before the
+// first wait has ended (the set-up: meshing, factorising) kStallSetup seconds.
+constexpr double kStallFactor = 20, kStallFloor = 60, kStallSetup = 600;
+double g_longest_wait = -1;
+
+double stall_limit() {
+  if (g_stall_fixed > 0) return g_stall_fixed;
+  return g_longest_wait < 0 ? kStallSetup : std::max(kStallFloor, kStallFactor * g_longest_wait);
+}
+
+std::string stall_rule() {
+  if (g_stall_fixed > 0) return fmt::format("output.stall_timeout = {:g} s", g_stall_fixed);
+  return g_longest_wait < 0
+             ? fmt::format("automatic limit during set-up: {:g} s; output.stall_timeout sets one",
+                           kStallSetup)
+             : fmt::format("automatic limit: {:g} x the longest wait so far ({:.3g} s), at least "
+                           "{:g} s; output.stall_timeout sets one",
+                           kStallFactor, g_longest_wait, kStallFloor);
+}
 
 // Set by SIGUSR1 (./fsi sends it when it is asked to stop; mpirun forwards it to every program).
 volatile std::sig_atomic_t g_stop_signal = 0;
@@ -49,14 +83,116 @@ extern "C" void on_stop_signal(int) { g_stop_signal = 1; }
 // A waiting program tests its request and yields the core between tests: with more programs
 // than cores it hands the core to a program ready to run there, and picks its message up at the
 // next test; a sleep would hand the core over no sooner and wake late (`./fsi bench protocol`,
-// common/PROTOCOL.md).
-void wait_yielding(MPI_Request& req) {
-  int done = 0;
-  MPI_Test(&req, &done, MPI_STATUS_IGNORE);
-  while (!done) {
+// common/PROTOCOL.md). Every 256 tests it looks at the clock: a wait beyond stall_limit() is a
+// stalled peer, reported through the funnel with `what` (which message, which peer).
+// A solver waits on the coupler half as long again as the limit: the coupler, which waits on the
+// program that is really stuck, reports first and names it.
+template <class Test>
+void wait_until(Test&& test, const std::function<std::string()>& what, double scale) {
+  if (test()) return;
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  for (unsigned k = 1;; ++k) {
     std::this_thread::yield();
-    MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+    if (test()) break;
+    if (k % 256 == 0) {
+      const double waited = std::chrono::duration<double>(clock::now() - t0).count();
+      if (waited > scale * stall_limit())
+        fail("no {} after waiting {:.1f} s: that program is stopped or hung ({}{}); ending the job",
+             what(), waited, stall_rule(), scale != 1 ? fmt::format(", x {:g} for a solver", scale) : "");
+    }
   }
+  g_longest_wait = std::max(g_longest_wait,
+                            std::chrono::duration<double>(clock::now() - t0).count());
+}
+
+// /proc/PID/stat: the state letter and the start time (field 22) of a process; state 0 when
+// there is no such process.
+std::pair<char, unsigned long long> process_stat(long pid) {
+  std::ifstream f("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (!std::getline(f, line)) return {0, 0};
+  const auto close = line.rfind(')');
+  if (close == std::string::npos) return {0, 0};
+  std::istringstream rest(line.substr(close + 2));
+  char state = 0;
+  rest >> state;
+  std::string skip;
+  for (int field = 4; field < 22; ++field) rest >> skip;
+  unsigned long long start = 0;
+  rest >> start;
+  return {state, start};
+}
+
+// The launcher's watch: ./fsi exports its PID as FSI_LAUNCHER_PID; a thread of every program
+// looks twice a second whether that process still lives (not gone, not a zombie, not a new
+// process under a reused PID). When it is gone (killed, even by SIGKILL, which it cannot
+// trap), the program says so and exits; mpirun, left with dead programs, ends the rest.
+void watch_launcher(const char* role) {
+  const char* env = std::getenv("FSI_LAUNCHER_PID");
+  if (!env || !*env) return;
+  char* end = nullptr;
+  const long pid = std::strtol(env, &end, 10);
+  if (*end != 0 || pid <= 1) return;
+  const auto first = process_stat(pid);
+  if (first.first == 0 || first.first == 'Z' || first.first == 'X') return;  // not ours to watch
+  const unsigned long long start = first.second;
+  std::thread([role, pid, start] {
+    for (;;) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(500));
+      const auto [s, t] = process_stat(pid);
+      if (s == 0 || s == 'Z' || s == 'X' || t != start) {
+        // Not MPI_Abort: MPI is not ours to call from this thread. Every program watches and
+        // exits on its own within the same half second.
+        std::fprintf(stderr, "[%s] ERROR: the launcher ./fsi (pid %ld) is gone (killed?): ending "
+                     "the job\n", role, pid);
+        std::fflush(stderr);
+        std::_Exit(1);
+      }
+    }
+  }).detach();
+}
+
+// The output folder's lock: an flock on DIR/.lock held by the first process of the job for as
+// long as it lives (the kernel drops it when the process ends, however it ends, so a lock left
+// by a dead run is simply taken). The file says who holds it.
+constexpr const char* kLockFile = ".lock";
+
+void lock_out_dir(const std::filesystem::path& dir, const std::string& scene) {
+  const auto file = dir / kLockFile;
+  const int fd = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0)
+    throw InputError(fmt::format("cannot create the lock file '{}' of the output folder: {}",
+                                 file.string(), std::strerror(errno)));
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    std::string holder;
+    std::ifstream in(file);
+    std::getline(in, holder);
+    ::close(fd);
+    throw InputError(fmt::format(
+        "output folder '{}' is in use by another run that is still running ({}); wait for it to "
+        "end, or give this run another folder",
+        dir.string(), holder.empty() ? "holder unknown" : holder));
+  }
+  char host[256] = "?";
+  ::gethostname(host, sizeof host - 1);
+  const std::string who = fmt::format("pid {} on {}, scene {}\n", ::getpid(), host, scene);
+  if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, who.data(), who.size(), 0) < 0) {
+    // The lock holds without its text; only the message of a refused run is poorer.
+  }
+  // fd stays open (and locked) until this process ends.
+}
+
+// Whether DIR holds anything but its lock file.
+bool has_contents(const std::filesystem::path& dir) {
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().filename() != kLockFile) return true;
+  return false;
+}
+
+void clear_contents(const std::filesystem::path& dir) {
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().filename() != kLockFile) std::filesystem::remove_all(e.path());
 }
 
 }  // namespace
@@ -144,6 +280,12 @@ CommonSettings read_common(const SceneTable& root) {
   s.dt = time.positive("dt");
   s.t_end = time.positive("t_end");
   const double n = s.t_end / s.dt;
+  // The step counter is a long and t^n = n dt; beyond 2^53 steps n itself is no longer exact in
+  // double precision (nor lround defined near the long's end): refused, not wrapped.
+  if (!(n <= kMaxSteps))
+    time.fail("t_end", fmt::format("= {:g} is {:.3g} steps of time.dt = {:g}, more than the {:.3g} "
+                                   "steps a run can count; shorten t_end or lengthen dt",
+                                   s.t_end, n, s.dt, kMaxSteps));
   s.steps = std::lround(n);
   if (std::abs(static_cast<double>(s.steps) - n) > kStepCountTolerance * n) s.steps = static_cast<long>(std::ceil(n));
   if (s.steps < 1) s.steps = 1;
@@ -154,6 +296,7 @@ CommonSettings read_common(const SceneTable& root) {
     s.progress_every = out->integer("progress", 0);
     s.checkpoint_interval = out->non_negative("checkpoint_interval", 0.0);
     if (s.progress_every < 0) out->fail("progress", fmt::format("must be >= 0, got {}", s.progress_every));
+    s.stall_timeout = out->non_negative("stall_timeout", 0.0);
     out->finish();
   }
   if (const auto test = root.optional_table("test")) {
@@ -162,6 +305,11 @@ CommonSettings read_common(const SceneTable& root) {
       s.fail_role = test->choice("fail_role", roles);
       s.fail_step = test->integer("fail_step");
       if (s.fail_step < 0) test->fail("fail_step", fmt::format("must be >= 0, got {}", s.fail_step));
+    }
+    if (test->has("hang_role")) {
+      s.hang_role = test->choice("hang_role", roles);
+      s.hang_step = test->integer("hang_step");
+      if (s.hang_step < 0) test->fail("hang_step", fmt::format("must be >= 0, got {}", s.hang_step));
     }
     if (test->has("bad_protocol_version"))
       s.bad_version_role = test->choice("bad_protocol_version", roles);
@@ -174,13 +322,14 @@ CommonSettings read_common(const SceneTable& root) {
 std::filesystem::path choose_out_dir(const std::filesystem::path& root, const std::string& name,
                                      bool overwrite) {
   namespace fs = std::filesystem;
+  fs::create_directories(root);
   fs::path dir = root / name;
   if (overwrite) {
-    fs::remove_all(dir);
-  } else {
-    for (int k = 2; fs::exists(dir); ++k) dir = root / fmt::format("{}-{}", name, k);
+    fs::create_directories(dir);
+    return dir;
   }
-  fs::create_directories(dir);
+  // create_directory is one mkdir: of two runs racing for a name, exactly one gets it.
+  for (int k = 2; !fs::create_directory(dir); ++k) dir = root / fmt::format("{}-{}", name, k);
   return dir;
 }
 
@@ -190,7 +339,14 @@ void Link::send_bytes(const std::vector<std::byte>& bytes, proto::Tag tag) {
   MPI_Request req;
   MPI_Isend(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, 0, static_cast<int>(tag), m_comm,
             &req);
-  wait_yielding(req);
+  wait_until(
+      [&] {
+        int done = 0;
+        MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+        return done != 0;
+      },
+      [&] { return fmt::format("delivery of message '{}' to {}", proto::tag_name(tag), role_name(m_peer)); },
+      m_peer == Role::coupler ? 1.5 : 1.0);
   m_sent += bytes.size();
 }
 
@@ -198,11 +354,13 @@ std::vector<std::byte> Link::recv_bytes(proto::Tag expected) {
   int flag = 0;
   MPI_Message msg;
   MPI_Status status;
-  MPI_Improbe(0, MPI_ANY_TAG, m_comm, &flag, &msg, &status);
-  while (!flag) {
-    std::this_thread::yield();
-    MPI_Improbe(0, MPI_ANY_TAG, m_comm, &flag, &msg, &status);
-  }
+  wait_until(
+      [&] {
+        MPI_Improbe(0, MPI_ANY_TAG, m_comm, &flag, &msg, &status);
+        return flag != 0;
+      },
+      [&] { return fmt::format("message '{}' from {}", proto::tag_name(expected), role_name(m_peer)); },
+      m_peer == Role::coupler ? 1.5 : 1.0);
   if (status.MPI_TAG != static_cast<int>(expected))
     fail("protocol error: expected message '{}' from {}, got '{}'", proto::tag_name(expected),
          role_name(m_peer), proto::tag_name(static_cast<proto::Tag>(status.MPI_TAG)));
@@ -235,6 +393,25 @@ bool Runtime::stop_requested() const {
 void Runtime::check_fault(long step) const {
   if (m_settings.fail_role == name() && step == m_settings.fail_step)
     fail("test fault injected at step {} (test.fail_role = \"{}\")", step, name());
+  if (m_settings.hang_role == name() && step == m_settings.hang_step) {
+    std::fprintf(stderr, "[%s] test hang injected at step %ld (test.hang_role): waiting forever\n",
+                 name(), step);
+    for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
+  }
+}
+
+namespace {
+const Scene* g_scene = nullptr;  // this process's scene, for extreme_constants_hint()
+}
+
+std::string extreme_constants_hint() {
+  // 1e9: beyond any coefficient of a scene in its users' units (moduli in Pa reach 1e12 only
+  // for diamond; the hint says "likely", and only when a check has already tripped).
+  constexpr double kExtreme = 1e9;
+  if (!g_scene) return {};
+  const auto found = g_scene->extreme_numbers(kExtreme);
+  if (found.empty()) return {};
+  return fmt::format("; the scene has extreme values, a likelier cause: {}", fmt::join(found, ", "));
 }
 
 void abort_job(const char* role, const std::string& message) {
@@ -297,6 +474,7 @@ int run_program(Role role, int argc, char** argv, const std::function<void(Runti
   MPI_Init(&argc, &argv);
   Runtime rt;
   rt.m_role = role;
+  watch_launcher(role_name(role));
   rt.m_t0 = MPI_Wtime();
   try {
     int world_rank = 0, world_size = 1;
@@ -313,9 +491,11 @@ int run_program(Role role, int argc, char** argv, const std::function<void(Runti
 
     const Options opts = parse_options(argc, argv, rt.name());
     rt.m_scene = std::make_unique<Scene>(opts.scene);
+    g_scene = rt.m_scene.get();
     const SceneTable root = rt.m_scene->root();
     rt.m_roles = roles_needed(root);
     rt.m_settings = read_common(root);
+    g_stall_fixed = rt.m_settings.stall_timeout;
     for (const char* k : {"fluid", "solid", "fiber", "coupler"}) root.skip(k);
     root.finish();
     rt.m_time_limit = opts.time_limit;
@@ -372,20 +552,21 @@ int run_program(Role role, int argc, char** argv, const std::function<void(Runti
 
     // Output folder: chosen by the first process of the job, the same for all.
     std::string dir;
-    if (job_rank == 0)
-      dir = opts.restart ? opts.restart->string()
-            : (opts.out_dir ? [&] {
-              if (std::filesystem::exists(*opts.out_dir) && !opts.overwrite &&
-                  !std::filesystem::is_empty(*opts.out_dir))
-                throw InputError(fmt::format(
-                    "output folder '{}' exists and is not empty; pass --overwrite to replace it",
-                    opts.out_dir->string()));
-              if (opts.overwrite) std::filesystem::remove_all(*opts.out_dir);
-              std::filesystem::create_directories(*opts.out_dir);
-              return *opts.out_dir;
-            }()
-                           : choose_out_dir(opts.out_root, rt.m_settings.name, opts.overwrite))
-                .string();
+    if (job_rank == 0) {
+      const std::filesystem::path d =
+          opts.restart  ? *opts.restart
+          : opts.out_dir ? *opts.out_dir
+                         : choose_out_dir(opts.out_root, rt.m_settings.name, opts.overwrite);
+      std::filesystem::create_directories(d);
+      // Locked before anything in it is looked at or removed: a live run's folder is refused
+      // (a restart resumes in its folder and keeps what it holds).
+      lock_out_dir(d, opts.scene.string());
+      if (opts.overwrite) clear_contents(d);
+      else if (opts.out_dir && has_contents(d))
+        throw InputError(fmt::format(
+            "output folder '{}' exists and is not empty; pass --overwrite to replace it", d.string()));
+      dir = d.string();
+    }
     long len = static_cast<long>(dir.size());
     MPI_Bcast(&len, 1, MPI_LONG, 0, job);
     dir.resize(static_cast<std::size_t>(len));

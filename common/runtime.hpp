@@ -58,9 +58,15 @@ struct CommonSettings {
   double output_interval = 0;  // output.interval: field output every this much time; 0 = none
   long progress_every = 0;     // output.progress: 0 = automatic
   double checkpoint_interval = 0;  // output.checkpoint_interval: checkpoint every this much time
+  // output.stall_timeout: seconds a program waits for a message before it reports its peer
+  // stalled and ends the job; 0 = automatic (20 x the longest wait so far, at least 60 s; 600 s
+  // before the first message has arrived)
+  double stall_timeout = 0;
   // [test]: fault switches used by the test suite only
   std::string fail_role;    // test.fail_role: this program fails ...
   long fail_step = -1;      // ... at the start of this step
+  std::string hang_role;     // test.hang_role: this program hangs (sleeps forever) ...
+  long hang_step = -1;       // ... at the start of this step
   std::string bad_version_role;  // test.bad_protocol_version: this program announces a wrong version
   bool work_ahead = true;   // test.work_ahead = false: the solvers do no work ahead of their input
 };
@@ -138,8 +144,10 @@ int run_program(Role role, int argc, char** argv, const std::function<void(Runti
 // Print "[role] ERROR: message" and abort the whole job.
 [[noreturn]] void abort_job(const char* role, const std::string& message);
 
-// Choose the output folder under `root` for scene `name`: root/name, or root/name-2, -3, ... if
-// that exists (never silently overwritten), or root/name emptied when `overwrite`.
+// Choose and create the output folder under `root` for scene `name`: root/name, or root/name-2,
+// -3, ... if that exists (never silently overwritten; each made by one mkdir, so two runs racing
+// for a name get different folders), or root/name itself when `overwrite` (run_program empties
+// it once it holds the folder's lock, DIR/.lock, which a live run keeps).
 std::filesystem::path choose_out_dir(const std::filesystem::path& root, const std::string& name,
                                      bool overwrite);
 

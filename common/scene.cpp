@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <set>
@@ -439,6 +440,56 @@ std::vector<SceneTable> SceneTable::tables(std::string_view key) const {
     out.push_back(SceneTable(m_doc, &arr[i], fmt::format("{}[{}]", key_path(key), i)));
   }
   return out;
+}
+
+namespace {
+
+void collect_extremes(const Value& v, const std::string& path, double threshold,
+                      std::vector<std::pair<double, std::string>>& out) {
+  if (v.is_table()) {
+    for (const auto& [k, x] : v.as_table()) collect_extremes(x, path.empty() ? k : path + "." + k, threshold, out);
+  } else if (v.is_array()) {
+    const auto& a = v.as_array();
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      // Arrays of tables: body[0].material...; arrays of numbers: size[1].
+      collect_extremes(a[i], fmt::format("{}[{}]", path, i), threshold, out);
+    }
+  } else if (v.is_floating() || v.is_integer()) {
+    const double x = v.is_floating() ? v.as_floating() : static_cast<double>(v.as_integer());
+    if (!std::isfinite(x) || std::abs(x) >= threshold)
+      out.emplace_back(std::isfinite(x) ? std::abs(x) : HUGE_VAL, fmt::format("{} = {}", path, show(v)));
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> Scene::extreme_numbers(double threshold) const {
+  std::vector<std::pair<double, std::string>> found;
+  collect_extremes(m_doc->root, "", threshold, found);
+  std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<std::string> r;
+  for (auto& f : found) r.push_back(std::move(f.second));
+  return r;
+}
+
+double machine_memory() {
+  if (const char* env = std::getenv("FSI_MEMORY_BYTES"); env && *env) return std::atof(env);
+  std::ifstream in("/proc/meminfo");
+  std::string name;
+  double kib = 0;
+  while (in >> name >> kib) {
+    if (name == "MemTotal:") return kib * 1024.0;
+    in.ignore(1 << 20, '\n');
+  }
+  return 0;
+}
+
+void check_memory(const SceneTable& t, std::string_view key, double bytes, const std::string& what) {
+  const double have = machine_memory();
+  if (have > 0 && !(bytes <= have))
+    t.fail(key, fmt::format("asks for {}, which needs at least {:.3g} GB of memory; this machine "
+                            "has {:.3g} GB (MemTotal)",
+                            what, bytes / 1e9, have / 1e9));
 }
 
 }  // namespace fsi

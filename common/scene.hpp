@@ -91,10 +91,27 @@ class Scene {
   std::uint64_t hash() const;            // FNV-1a of the contents
   // The effective scene: every key read so far, with defaults filled in, as TOML text.
   std::string effective_toml() const;
+  // Every number of the scene with |value| >= `threshold` (or not finite), as "key = value",
+  // largest first: what a health check names as the likely cause of a blow-up.
+  std::vector<std::string> extreme_numbers(double threshold) const;
 
  private:
   std::shared_ptr<SceneDoc> m_doc;
 };
+
+// The machine's memory in bytes (MemTotal of /proc/meminfo, or FSI_MEMORY_BYTES when set: a
+// test's stand-in for a smaller machine); 0 when unknown.
+double machine_memory();
+// Before allocating what a scene asks for: fails at `key` of `t` when the estimated `bytes`
+// (`what`: "2e+12 grid cells") exceed the machine's memory. Estimates are lower bounds (the
+// large arrays only), so what is refused can never fit.
+void check_memory(const SceneTable& t, std::string_view key, double bytes, const std::string& what);
+
+// (runtime.cpp) For a health check that trips (CFL, singular matrix, NaN): the scene's extreme constants, the
+// likelier cause than the check's own knob: "; the scene has extreme values, a likely cause:
+// coupler.kappa = 1e12". Empty when the scene has none (|value| >= 1e9 or not finite) or in a
+// process without a scene.
+std::string extreme_constants_hint();
 
 // Levenshtein distance, for "did you mean".
 std::size_t edit_distance(std::string_view a, std::string_view b);

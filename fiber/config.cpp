@@ -129,6 +129,7 @@ Config read_config(const fsi::SceneTable& fiber) {
   // An empty [fiber] is a scene without fibers (the program then runs with nothing to move).
   const auto tables = fiber.tables("fiber");
   std::map<std::string, std::string> names;  // name -> key, for duplicates and probes
+  double markers = 0;  // over every fiber table so far, for the memory estimate
   for (const auto& t : tables) {
     FiberSpec f;
     f.key = t.path();
@@ -198,6 +199,13 @@ Config read_config(const fsi::SceneTable& fiber) {
     const long count = t.positive_integer("count", 1);
     const Vec2 spacing = count > 1 ? vec(t.vec2("spacing")) : vec(t.vec2("spacing", {0.0, 0.0}));
     if (count > 1 && spacing.norm() == 0) t.fail("spacing", "must be non-zero for a row of fibers (count > 1)");
+    // About 40 doubles a marker (X^n, X^(n-1), velocity, forces, tension, the tension solve,
+    // the repulsion's cell lists), over every fiber of the scene so far: less than it takes.
+    constexpr double kBytesPerMarker = 40 * 8;
+    markers += static_cast<double>(count) * static_cast<double>(segments + 1);
+    fsi::check_memory(t, "count", markers * kBytesPerMarker,
+                      fmt::format("{} fiber(s) of {} markers ({:.3g} markers in the scene so far)",
+                                  count, segments + 1, markers));
     t.finish();
 
     for (long i = 0; i < count; ++i) {

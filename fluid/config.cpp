@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "error.hpp"
 #include "scene.hpp"
@@ -100,6 +101,20 @@ void validate(const Config& c, double dt) {
   if (x_stretched && px) bad(c, "fluid.sponge: the sponge stretches x, which is periodic");
   if (!(dt > 0)) bad(c, fmt::format("time.dt must be > 0, got {}", dt));
   const double nu = c.viscosity / c.density;
+  {
+    // The diffusion number d = nu dt / h_min^2. A step adds d times the stencil's Laplacian to
+    // u^n; once d eps exceeds sqrt(eps) (d > 1 / sqrt(eps) = 6.7e7) fewer than half of double
+    // precision's digits of u^n survive the step, and soon nu dt / h^2 overflows: the flow is
+    // no longer stepped, whichever diffusion scheme. Refused as the viscosity's fault.
+    const double hmin = std::min(min_width(c.x), min_width(c.y));
+    const double d = nu * dt / (hmin * hmin);
+    const double d_max = 1.0 / std::sqrt(std::numeric_limits<double>::epsilon());
+    if (!std::isfinite(nu) || !(d <= d_max))
+      bad(c, fmt::format("fluid.viscosity = {:g} (with fluid.density = {:g}: nu = {:g}) is beyond what "
+                         "double precision can step: the diffusion number nu dt / h^2 = {:.3g} "
+                         "(time.dt = {:g}, h = {:.3g}) exceeds 1/sqrt(machine epsilon) = {:.3g}",
+                         c.viscosity, c.density, nu, d, dt, hmin, d_max));
+  }
   if (!c.implicit) {
     const double lim = explicit_diffusion_limit(c);
     if (dt > lim) {
@@ -187,6 +202,13 @@ Config read_config(const fsi::SceneTable& f, double dt) {
     if (n != std::floor(n)) g.fail("cells", fmt::format("must be integers, got {}", n));
     if (n < 4) g.fail("cells", fmt::format("must be >= 4 in each direction for the stencil, got {}", n));
   }
+  // About 50 doubles a cell (velocity, pressure, predictor, explicit terms, forcing, volume
+  // fractions, the Poisson solver's transforms): less than the fluid takes.
+  constexpr double kBytesPerCell = 50 * 8;
+  fsi::check_memory(g, "cells", cells[0] * cells[1] * kBytesPerCell,
+               fmt::format("{:g} x {:g} = {:.3g} grid cells", cells[0], cells[1], cells[0] * cells[1]));
+  if (cells[0] > 1e9 || cells[1] > 1e9)
+    g.fail("cells", fmt::format("must be at most 1e9 in each direction, got [{:g}, {:g}]", cells[0], cells[1]));
   const auto size = g.vec2("size");
   if (!(size[0] > 0 && size[1] > 0)) g.fail("size", fmt::format("must be > 0, got [{}, {}]", size[0], size[1]));
   const auto origin = g.vec2("origin", {0.0, 0.0});

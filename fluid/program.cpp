@@ -108,12 +108,12 @@ void FluidProgram::check_health(long step, double t, double dt) {
   m_cfl = c.value;
   std::string what;
   if (!std::isfinite(c.value)) {
-    what = "the velocity is not finite (NaN or Inf)";
+    what = "the velocity is not finite (NaN or Inf)" + fsi::extreme_constants_hint();
   } else if (c.value > m_cfg.cfl_max) {
     what = fmt::format(
         "CFL number {:.4g} above fluid.health.cfl_max = {:g} in cell ({}, {}) at "
-        "(x, y) = ({:.6g}, {:.6g}); lower time.dt",
-        c.value, m_cfg.cfl_max, c.i, c.j, c.x, c.y);
+        "(x, y) = ({:.6g}, {:.6g}); lower time.dt{}",
+        c.value, m_cfg.cfl_max, c.i, c.j, c.x, c.y, fsi::extreme_constants_hint());
   } else if (step % m_cfg.health_every == 0) {
     const Extremum d = max_divergence(*m_solver);
     m_div = d.value;

@@ -51,8 +51,11 @@ def main():
     a = p.parse_args()
     if not os.path.isdir(a.out):
         raise SystemExit(f"plot_run.py: no output folder {a.out}")
-    png, shows = picture.picture(a.out)
-    print(f"picture: {os.path.relpath(png)} ({shows})")
+    try:
+        png, shows = picture.picture(a.out)
+        print(f"picture: {os.path.relpath(png)} ({shows})")
+    except picture.NoFields as e:
+        print(f"no picture: {e} (set [output] interval for field output)")
     made = [] if a.no_csv else csv_plots(a.out)
     if made:
         print("plots:", ", ".join(os.path.relpath(p) for p in made))

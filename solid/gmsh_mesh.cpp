@@ -4,12 +4,14 @@
 #include <gmsh.h>
 
 #include <algorithm>
+#include <exception>
 #include <fstream>
 #include <map>
 #include <set>
 #include <unordered_map>
 
 #include "error.hpp"
+#include "runtime.hpp"
 
 namespace solid {
 
@@ -31,6 +33,34 @@ struct GmshScope {
     gmsh::option::setNumber("General.Verbosity", 1);
   }
   ~GmshScope() { gmsh::finalize(); }
+};
+
+// Gmsh's mesher throws some of its errors (a degenerate surface: "Unable to recover the edge")
+// through code that cannot pass them on, which ends in std::terminate ("terminate called ...",
+// SIGABRT, no file named). While Gmsh runs, a terminate handler names the key and the file and
+// ends the job through the funnel instead. Gmsh runs on the main thread, where the funnel may
+// call MPI.
+struct TerminateScope {
+  static inline std::string context;  // "solid.body[0].mesh: Gmsh could not mesh 'x.geo'"
+  std::terminate_handler previous;
+  explicit TerminateScope(std::string what) : previous(std::set_terminate(&TerminateScope::handler)) {
+    context = std::move(what);
+  }
+  ~TerminateScope() { std::set_terminate(previous); }
+  [[noreturn]] static void handler() {
+    std::string why = "unknown error";
+    try {
+      if (const auto e = std::current_exception()) std::rethrow_exception(e);
+    } catch (const std::string& s) {
+      why = s;
+    } catch (const char* s) {
+      why = s;
+    } catch (const std::exception& e) {
+      why = e.what();
+    } catch (...) {
+    }
+    fsi::abort_job("solid", fmt::format("{}: {}", context, why));
+  }
 };
 
 std::string last_gmsh_error() {
@@ -63,6 +93,8 @@ Mesh read_gmsh(const std::filesystem::path& file, const GmshOptions& options,
   }
 
   GmshScope scope(options);
+  const TerminateScope guard(fmt::format("{}: Gmsh could not {} '{}'", key,
+                                         ext == ".geo" ? "mesh" : "read", name));
   try {
     gmsh::open(name);
     if (ext == ".geo") {

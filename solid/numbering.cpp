@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "error.hpp"
+#include "scene.hpp"
 #include "solver_body.hpp"
 
 namespace solid {
@@ -194,11 +195,20 @@ bool Solver::factorize_cached() {
 }
 
 void Solver::factorize(const std::string& when) {
-  if (!factorize_cached())
-    fsi::fail(
+  if (factorize_cached()) return;
+  // Overflowing material constants (a modulus of 1e300) make the entries infinite or NaN, which
+  // the factorisation reports as singular: named first, as the cause.
+  const double* v = m_matrix.valuePtr();
+  for (Eigen::Index k = 0; k < m_matrix.nonZeros(); ++k)
+    if (!std::isfinite(v[k]))
+      fsi::fail(
+          "the stiffness matrix at {} has entries that are not finite (Inf or NaN): the material "
+          "constants or the time step overflow double precision{}",
+          when, fsi::extreme_constants_hint());
+  fsi::fail(
         "the stiffness matrix is singular at {}: a body is not held against rigid "
-        "motion (no constraint, no mass, no contact) or an element has collapsed",
-        when);
+        "motion (no constraint, no mass, no contact) or an element has collapsed{}",
+        when, fsi::extreme_constants_hint());
 }
 
 }  // namespace solid

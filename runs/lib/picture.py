@@ -58,6 +58,11 @@ def _nearest(times, t):
     return int(np.argmin(np.abs(np.asarray(times) - t)))
 
 
+
+class NoFields(SystemExit):
+    """A run that wrote no field output ([output] interval = 0): nothing to draw. Uncaught, it
+    ends the script with its message."""
+
 class Run:
     """What a run folder holds, read once: the frames' times and, per frame, the field, the bodies
     and the fibers."""
@@ -71,7 +76,7 @@ class Run:
         self.has_solid = self._has_steps("solid.h5")
         self.has_fiber = self._has_steps("fiber.h5")
         if not (self.has_fluid or self.has_solid or self.has_fiber):
-            raise SystemExit(f"{folder}: no fluid.h5, solid.h5 or fiber.h5 with output steps")
+            raise NoFields(f"{folder}: no fluid.h5, solid.h5 or fiber.h5 with output steps")
         self._read_fluid()
         self._read_solid()
         self._read_fiber()

@@ -177,7 +177,7 @@ TEST_CASE("output folders are never silently overwritten") {
   CHECK(a.filename() == "case");
   CHECK(b.filename() == "case-2");
   CHECK(std::filesystem::exists(a / "keep.txt"));
+  // --overwrite: the same folder (emptied by run_program once it holds the folder's lock).
   const auto c = fsi::choose_out_dir(root, "case", true);
   CHECK(c == a);
-  CHECK(!std::filesystem::exists(a / "keep.txt"));
 }
