@@ -19,6 +19,7 @@ did not happen before T.
 """
 import argparse
 import glob
+import json
 import os
 import re
 import shutil
@@ -121,8 +122,9 @@ def main():
             log = stop_by_signal(a.bin, full, stopped)
             steps = sorted(int(os.path.basename(p)[5:]) for p in glob.glob(os.path.join(stopped, "checkpoint", "step_*")))
             print(f"restart_same: stopped by the signal; checkpoints at steps {steps}")
-            if "stopped" not in log and not steps:
-                sys.exit("restart_same: the signalled run did not stop early")
+            with open(os.path.join(stopped, "summary.json")) as f:
+                if "stopped_at_step" not in json.load(f):
+                    sys.exit("restart_same: the signalled run did not stop early (it reached T first)")
         # A crash while writing the next checkpoint: a folder with some programs' files only.
         partial = os.path.join(stopped, "checkpoint", "step_99999999")
         os.makedirs(partial)
