@@ -10,7 +10,7 @@ DEFAULT_SCENE=$ROOT/runs/default/scene.toml
 PACKAGES=(g++ cmake make pkg-config libeigen3-dev libopenmpi-dev openmpi-bin libhdf5-dev
           libfftw3-dev catch2 libfmt-dev libtoml11-dev gmsh libgmsh-dev libspectra-dev
           nlohmann-json3-dev libsuitesparse-dev python3 python3-matplotlib python3-h5py
-          python3-numpy)
+          python3-numpy python3-mpi4py python3-gmsh)
 # What only the tests need: ParaView (the XDMF test) and a virtual display for it to draw on.
 TEST_PACKAGES=(python3-paraview xvfb xauth libgl1-mesa-dri libglx-mesa0)
 
@@ -92,11 +92,13 @@ mpirun_flags() {
   echo "${f[@]}"
 }
 
-# plan SCENE: sets ROLES (programs the scene needs) and NAME (its output folder name).
+# plan SCENE: sets ROLES (roles the scene needs), PROGRAMS (the program playing each, in the same
+# order: `[solid] program` may name another than `solid`) and NAME (its output folder name).
 plan() {
   local out
   out=$("$BIN/fsi-plan" "$1") || exit 1
   ROLES=$(sed -n 's/^roles: //p' <<<"$out")
+  PROGRAMS=$(sed -n 's/^programs: //p' <<<"$out")
   NAME=$(sed -n 's/^name: //p' <<<"$out")
 }
 
@@ -106,7 +108,7 @@ compose() {
   plan "$scene"
   CMD=(mpirun $(mpirun_flags))
   local first=1
-  for r in $ROLES; do
+  for r in $PROGRAMS; do
     [ $first -eq 1 ] || CMD+=(:)
     CMD+=(-n 1 "$BIN/$r" "$scene" "$@")
     first=0

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -17,8 +18,19 @@
 namespace fsi::proto {
 
 // Bump on any change of a message's layout or of the message order.
-inline constexpr std::int32_t kVersion = 5;
+inline constexpr std::int32_t kVersion = 6;
 inline constexpr std::uint32_t kMagic = 0x4d495346;  // "FSIM"
+
+// 64-bit FNV-1a of bytes: the handshake's scene and output-options hashes (PROTOCOL.md,
+// start-up), so that a program in any language computes the same (since version 6).
+inline std::uint64_t fnv1a(std::string_view bytes) {
+  std::uint64_t h = 14695981039346656037ull;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
 
 enum class Tag : std::int32_t {
   // set-up, once, in this order

@@ -526,7 +526,9 @@ int run_program(Role role, int argc, char** argv, const std::function<void(Runti
                 rt.m_scene->hash(),
                 rt.m_roles[role] ? 1 : 0,
                 0,
-                std::hash<std::string>{}(fmt::format(
+                // FNV-1a of "ROOT|DIR|true/false|RESTART|STEP" (PROTOCOL.md, start-up), not
+                // std::hash: a program in another language computes the same.
+                proto::fnv1a(fmt::format(
                     "{}|{}|{}|{}|{}", opts.out_root.string(), opts.out_dir ? opts.out_dir->string() : "-",
                     opts.overwrite, opts.restart ? opts.restart->string() : "-",
                     rt.m_restart_step.value_or(-1)))};

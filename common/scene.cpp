@@ -2,6 +2,8 @@
 // receives the defaults that readers fill in and becomes the effective scene.
 #include "scene.hpp"
 
+#include "protocol.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -111,14 +113,8 @@ SceneTable Scene::root() const { return SceneTable(m_doc, &m_doc->root, ""); }
 const std::filesystem::path& Scene::file() const { return m_doc->file; }
 const std::string& Scene::contents() const { return m_doc->contents; }
 
-std::uint64_t Scene::hash() const {
-  std::uint64_t h = 1469598103934665603ull;  // FNV-1a, 64 bit
-  for (unsigned char c : m_doc->contents) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
+// The handshake's scene hash (PROTOCOL.md, start-up): 64-bit FNV-1a of the file's bytes.
+std::uint64_t Scene::hash() const { return proto::fnv1a(m_doc->contents); }
 
 std::string Scene::effective_toml() const { return toml::format(m_doc->effective); }
 

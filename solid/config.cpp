@@ -264,6 +264,16 @@ int body_named(const fsi::SceneTable& t, const std::string& key, const std::stri
 Config read_config(const fsi::SceneTable& s, double fluid_density) {
   Config c;
   Settings& st = c.model.settings;
+  // Which program plays the solid role (./fsi and common/tools/plan.cpp read it): a scene for
+  // another one (solid_rigid/) is refused here rather than half read.
+  if (s.has("program")) {
+    const std::string program = s.string("program");
+    if (program != "solid")
+      s.fail("program", fmt::format("= \"{}\": this scene is for the program {}, not for solid; "
+                                    "launch {} in the solid role (./fsi run composes the job "
+                                    "from the scene)",
+                                    program, program, program));
+  }
   const std::string analysis = s.choice("analysis", {"dynamic", "static"}, "dynamic");
   st.analysis = analysis == "static" ? Analysis::statics : Analysis::dynamic;
   st.fluid_density = fluid_density;

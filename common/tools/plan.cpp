@@ -1,7 +1,10 @@
 // fsi-plan SCENE.toml: what the launcher needs to compose the mpirun line, read with the same
-// strict rules as the programs. Prints "roles: fluid solid coupler" and "name: <scene name>".
+// strict rules as the programs. Prints "roles: fluid solid coupler", "programs: fluid solid-rigid
+// coupler" (the program that plays each role, in the same order: `[solid] program`, by default the
+// role's own) and "name: <scene name>".
 // Bad input: "ERROR: ..." on stderr and exit code 1.
 #include <cstdio>
+#include <string>
 
 #include "runtime.hpp"
 
@@ -15,11 +18,24 @@ int main(int argc, char** argv) {
     const auto root = scene.root();
     const auto roles = fsi::roles_needed(root);
     const auto common = fsi::read_common(root);
+    // The solid role may be played by another program than `solid` (README, "Replacing a
+    // solver"); the others by their own.
+    std::string solid = "solid";
+    if (roles.need[static_cast<int>(fsi::Role::solid)]) {
+      const auto t = root.table("solid");
+      if (t.has("program")) solid = t.choice("program", {"solid", "solid-rigid"});
+    }
     for (const char* k : {"fluid", "solid", "fiber", "coupler"}) root.skip(k);
     root.finish();
     std::printf("roles:");
     for (int r = 0; r < fsi::kRoleCount; ++r)
       if (roles.need[r]) std::printf(" %s", fsi::role_name(static_cast<fsi::Role>(r)));
+    std::printf("\nprograms:");
+    for (int r = 0; r < fsi::kRoleCount; ++r)
+      if (roles.need[r])
+        std::printf(" %s", r == static_cast<int>(fsi::Role::solid)
+                               ? solid.c_str()
+                               : fsi::role_name(static_cast<fsi::Role>(r)));
     std::printf("\nname: %s\nsteps: %ld\n", common.name.c_str(), common.steps);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ERROR: %s\n", e.what());

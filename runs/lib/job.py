@@ -33,14 +33,15 @@ def out_dir(case):
 
 
 def roles(scene):
-    """The programs a scene file needs, as build/bin/fsi-plan says (its `roles:` line)."""
+    """The programs a scene file needs, as build/bin/fsi-plan says (its `programs:` line: the
+    program of each role, e.g. solid-rigid for the solid role)."""
     r = subprocess.run([os.path.join(BIN, "fsi-plan"), scene], capture_output=True, text=True)
     if r.returncode != 0:
         raise SystemExit(f"fsi-plan failed on {scene}:\n{r.stdout}{r.stderr}")
     for line in r.stdout.splitlines():
-        if line.startswith("roles:"):
+        if line.startswith("programs:"):
             return line.split(":", 1)[1].split()
-    raise SystemExit(f"fsi-plan printed no roles for {scene}:\n{r.stdout}")
+    raise SystemExit(f"fsi-plan printed no programs for {scene}:\n{r.stdout}")
 
 
 def command(scene, folder, programs):
