@@ -15,6 +15,9 @@ constexpr double kClosestTie = 1e-12;
 // A point farther than this from a vertex (relative to the edge length) takes the vertex's
 // direction as its normal; nearer, the vertex's direction is round-off and the edge's is used.
 constexpr double kVertexDistance = 1e-9;
+// How far (relative to its length) a slot's last edge is extended before the slot moves on to
+// the neighbouring edge or vertex: far above round-off of positions, far below a step's motion.
+constexpr double kKeepEdge = 1e-6;
 
 }  // namespace
 
@@ -95,7 +98,8 @@ void ContactSet::setup(const std::vector<const Mesh*>& meshes, const std::vector
     }
 }
 
-void ContactSet::detect(const std::vector<const std::vector<double>*>& x) {
+void ContactSet::detect(const std::vector<const std::vector<double>*>& x,
+                        const std::vector<double>& reach) {
   // Bounding boxes of every surface (xmin, ymin, xmax, ymax).
   std::vector<std::array<double, 4>> boxes(m_surfaces.size());
   for (std::size_t b = 0; b < m_surfaces.size(); ++b) {
@@ -109,11 +113,12 @@ void ContactSet::detect(const std::vector<const std::vector<double>*>& x) {
       box[3] = std::max(box[3], (*x[b])[2 * n + 1]);
     }
   }
-  for (auto& s : m_slots) detect_slot(s, x, boxes);
+  for (auto& s : m_slots) detect_slot(s, x, boxes, reach[s.slave_body]);
 }
 
 void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector<double>*>& x,
-                             const std::vector<std::array<double, 4>>& boxes) const {
+                             const std::vector<std::array<double, 4>>& boxes,
+                             double reach) const {
   const double px = (*x[s.slave_body])[2 * s.slave_node];
   const double py = (*x[s.slave_body])[2 * s.slave_node + 1];
   if (s.plane >= 0) {
@@ -127,9 +132,13 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
   const auto& box = boxes[s.master_body];
   const double dx = std::max({box[0] - px, 0.0, px - box[2]});
   const double dy = std::max({box[1] - py, 0.0, py - box[3]});
-  if ((dx > 0 || dy > 0) && !s.active) {
-    // Outside the master's box: a lower bound of the gap is enough to stay inactive.
-    s.gap = std::hypot(dx, dy);
+  const double box_distance = std::hypot(dx, dy);
+  if (box_distance > reach && !s.active) {
+    // Farther than `reach` from the master's box: a lower bound of the gap is enough to stay
+    // inactive. Nearer, the slot may become a constraint and needs its feature: a node just
+    // outside the box (two flat faces meeting at the box's edge, as touching folds do) used to
+    // become a candidate without one, and its row of B read the equations of node -1.
+    s.gap = box_distance;
     s.m0 = s.m1 = -1;
     return;
   }
@@ -138,21 +147,53 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
   double best = std::numeric_limits<double>::max();
   int best_edge = -1;
   double best_xi = 0;
+  // The edge of the last detection, if the slot had one: its parameter (not clamped) and squared
+  // distance to the edge extended by kKeepEdge of its length at both ends.
+  int last_edge = -1;
+  double last_d2 = 0, last_xi = 0;
   for (std::size_t k = 0; k < mesh.surface.size(); ++k) {
     const auto& e = mesh.surface[k];
     const double ax = xm[2 * e[0]], ay = xm[2 * e[0] + 1];
     const double ex = xm[2 * e[1]] - ax, ey = xm[2 * e[1] + 1] - ay;
     const double l2 = ex * ex + ey * ey;
-    double xi = ((px - ax) * ex + (py - ay) * ey) / l2;
-    xi = std::clamp(xi, 0.0, 1.0);
+    const double xi_line = ((px - ax) * ex + (py - ay) * ey) / l2;
+    const double xi = std::clamp(xi_line, 0.0, 1.0);
     const double qx = ax + xi * ex - px, qy = ay + xi * ey - py;
     const double d2 = qx * qx + qy * qy;
+    if (e[0] == s.m0 && e[1] == s.m1 && xi_line >= -kKeepEdge && xi_line <= 1 + kKeepEdge) {
+      const double rx = ax + xi_line * ex - px, ry = ay + xi_line * ey - py;
+      last_edge = static_cast<int>(k);
+      last_d2 = rx * rx + ry * ry;
+      last_xi = xi_line;
+    }
     // Ties (a vertex shared by two edges) prefer the edge whose interior holds the projection.
     const bool interior = xi > 0 && xi < 1;
     if (d2 < best * (1 - kClosestTie) || (d2 <= best * (1 + kClosestTie) && interior)) {
       best = d2;
       best_edge = static_cast<int>(k);
       best_xi = xi;
+    }
+  }
+  // A node at a vertex of the master (coincident nodes of mirrored meshes that touch, a node on
+  // a kink of the surface) is as close to both edges that share it; which one wins above is
+  // decided by round-off and flips from one Newton iteration to the next, and with it the normal
+  // and the gap's curvature, so Newton cycles and never settles. The slot keeps its last edge
+  // while its projection stays on that edge extended by kKeepEdge of its length and the
+  // distance is the closest within kKeepEdge of the edge's length (the gap then errs by at most
+  // that times the kink's angle).
+  if (last_edge >= 0) {
+    const auto& e = mesh.surface[last_edge];
+    const double ex = xm[2 * e[1]] - xm[2 * e[0]], ey = xm[2 * e[1] + 1] - xm[2 * e[0] + 1];
+    const double margin = kKeepEdge * kKeepEdge * (ex * ex + ey * ey);
+    if (std::sqrt(last_d2) <= std::sqrt(best) + std::sqrt(margin)) {
+      const double ax = xm[2 * e[0]], ay = xm[2 * e[0] + 1];
+      const double le = std::hypot(ex, ey);
+      s.m0 = e[0];
+      s.m1 = e[1];
+      s.xi = last_xi;
+      s.normal = {ey / le, -ex / le};
+      s.gap = (px - ax - last_xi * ex) * s.normal[0] + (py - ay - last_xi * ey) * s.normal[1];
+      return;
     }
   }
   const auto& e = mesh.surface[best_edge];

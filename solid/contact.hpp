@@ -39,7 +39,11 @@ class ContactSet {
              const std::vector<ContactPair>& pairs, const std::vector<ContactPlane>& planes);
   bool empty() const { return m_slots.empty(); }
   // Updates gap, feature and normal of every slot from current positions (one vector per body).
-  void detect(const std::vector<const std::vector<double>*>& x);
+  // reach[b] (one per body): a slave node of body b within this distance of a master's bounding
+  // box gets its closest feature; farther, an inactive slot keeps only the distance to the box
+  // (a lower bound of its gap, > reach) and no feature. A caller that turns slots with
+  // gap < reach into constraints so always finds their feature.
+  void detect(const std::vector<const std::vector<double>*>& x, const std::vector<double>& reach);
   std::vector<ContactSlot>& slots() { return m_slots; }
   const std::vector<ContactSlot>& slots() const { return m_slots; }
 
@@ -49,7 +53,7 @@ class ContactSet {
     std::vector<int> nodes;  // nodes on the surface
   };
   void detect_slot(ContactSlot& s, const std::vector<const std::vector<double>*>& x,
-                   const std::vector<std::array<double, 4>>& boxes) const;
+                   const std::vector<std::array<double, 4>>& boxes, double reach) const;
   std::vector<Surface> m_surfaces;
   std::vector<ContactPlane> m_planes;
   std::vector<ContactSlot> m_slots;

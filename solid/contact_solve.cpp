@@ -4,6 +4,7 @@
 // geometry (gap, closest point, normal) is contact.cpp's.
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 
@@ -33,20 +34,31 @@ int lcp_iteration_cap(int m) {
 // with S = B K^-1 B^T (symmetric, positive semi-definite) and q = g + B K^-1 R the gaps after the
 // step without contact. Equivalent to min 1/2 l^T S l + q^T l over l >= 0, solved exactly by the
 // Lawson-Hanson active-set method on S + eps I (eps = kSchurRegularisation max diag S). `tol` is
-// the accepted negative gap.
-Eigen::VectorXd solve_contact_lcp(const Eigen::MatrixXd& S0, const Eigen::VectorXd& q, double tol) {
+// the accepted negative gap. `warm` (one flag per constraint) is the active set to start from:
+// the last iteration's. Two slots on one contact (a two-way pair whose nodes coincide, as
+// mirrored meshes that touch have) are nearly the same constraint, and which of them carries
+// the force is decided by round-off; started cold, the method picked the other one from one
+// Newton iteration to the next and Newton stalled. Started from the last set, it keeps its
+// choice while that choice solves the problem.
+Eigen::VectorXd solve_contact_lcp(const Eigen::MatrixXd& S0, const Eigen::VectorXd& q, double tol,
+                                  const std::vector<bool>& warm) {
   const int m = static_cast<int>(q.size());
   Eigen::MatrixXd S = S0;
   S.diagonal().array() += kSchurRegularisation * S0.diagonal().cwiseAbs().maxCoeff();
   Eigen::VectorXd lambda = Eigen::VectorXd::Zero(m);
-  std::vector<bool> passive(m, false);
+  std::vector<bool> passive = warm;
+  bool start_warm = std::find(warm.begin(), warm.end(), true) != warm.end();
   for (int outer = 0; outer < lcp_iteration_cap(m); ++outer) {
-    const Eigen::VectorXd w = S * lambda + q;
-    int j = -1;
-    for (int i = 0; i < m; ++i)
-      if (!passive[i] && w[i] < -tol && (j < 0 || w[i] < w[j])) j = i;
-    if (j < 0) break;
-    passive[j] = true;
+    if (!start_warm) {
+      const Eigen::VectorXd w = S * lambda + q;
+      int j = -1;
+      for (int i = 0; i < m; ++i)
+        if (!passive[i] && w[i] < -tol && (j < 0 || w[i] < w[j])) j = i;
+      if (j < 0) break;
+      passive[j] = true;
+    }
+    // The passive set's equations; a multiplier that would turn negative leaves the set. From a
+    // warm start (lambda = 0 everywhere) the constraints with z <= 0 leave at once.
     for (int inner = 0; inner < lcp_iteration_cap(m); ++inner) {
       std::vector<int> p;
       for (int i = 0; i < m; ++i)
@@ -59,9 +71,15 @@ Eigen::VectorXd solve_contact_lcp(const Eigen::MatrixXd& S0, const Eigen::Vector
         for (int b = 0; b < np; ++b) Spp(a, b) = S(p[a], p[b]);
       }
       const Eigen::VectorXd z = Spp.ldlt().solve(rhs);
+      if (np == 0) break;
       if (z.minCoeff() > 0) {
         for (int a = 0; a < np; ++a) lambda[p[a]] = z[a];
         break;
+      }
+      if (start_warm) {
+        for (int a = 0; a < np; ++a)
+          if (z[a] <= 0) passive[p[a]] = false;
+        continue;
       }
       // Step from lambda towards z until the first passive multiplier reaches zero.
       double alpha = 1;
@@ -76,6 +94,7 @@ Eigen::VectorXd solve_contact_lcp(const Eigen::MatrixXd& S0, const Eigen::Vector
         }
       }
     }
+    start_warm = false;
   }
   return lambda;
 }
@@ -102,8 +121,12 @@ Solver::ContactLinearisation Solver::linearise_contact(
   if (m_contact.empty()) return con;
   auto& slots = m_contact.slots();
   std::vector<const std::vector<double>*> xs;
-  for (const auto& b : m_bodies) xs.push_back(&b->x);
-  m_contact.detect(xs);
+  std::vector<double> reach;
+  for (const auto& b : m_bodies) {
+    xs.push_back(&b->x);
+    reach.push_back(b->min_edge);
+  }
+  m_contact.detect(xs, reach);
   for (auto& s : slots) {
     if (s.active) {
       con.worst_gap = std::max(con.worst_gap, std::abs(s.gap));
@@ -122,6 +145,7 @@ Solver::ContactLinearisation Solver::linearise_contact(
   for (std::size_t k = 0; k < con.candidates.size(); ++k) {
     const ContactSlot& s = slots[con.candidates[k]];
     auto add = [&](int body, int node, double w) {
+      assert(node >= 0 && "a contact candidate without its master feature");
       const Body& B = *m_bodies[body];
       for (int i = 0; i < 2; ++i) {
         const int e = B.eq[2 * node + i];
@@ -205,7 +229,9 @@ void Solver::solve_contact(const ContactLinearisation& con, double gap_tol, Eige
   const Eigen::MatrixXd Y = m_linear.solve(Bt);
   const Eigen::MatrixXd S = Bt.transpose() * Y;
   q += Bt.transpose() * dx;
-  const Eigen::VectorXd lambda = solve_contact_lcp(S, q, gap_tol);
+  std::vector<bool> warm(nc);
+  for (int k = 0; k < nc; ++k) warm[k] = slots[con.candidates[k]].active;
+  const Eigen::VectorXd lambda = solve_contact_lcp(S, q, gap_tol, warm);
   dx += Y * lambda;
   for (auto& s : slots) {
     s.active = false;

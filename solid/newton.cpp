@@ -23,6 +23,10 @@ constexpr double kStallRatio = 0.5;
 // |inertia| + |K| |u|): some thousand machine epsilons, the rounding a sum of many such terms
 // accumulates.
 constexpr double kRoundoffFloor = 1e-12;
+// Contacts a failed step names (the active and penetrating ones, in slot order).
+constexpr int kContactsNamed = 8;
+// Residuals of the last iterations a failed step shows.
+constexpr std::size_t kResidualsNamed = 5;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -46,6 +50,7 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
   const double gap_tol = contact_gap_tolerance();
   Eigen::VectorXd dx(m_neq);
   double previous = std::numeric_limits<double>::infinity();
+  bool contact_active_or_open = false;  // the last iteration had contact candidates
 
   for (int it = 0;; ++it) {
     auto t0 = clock::now();
@@ -57,6 +62,7 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
     rep.residuals.push_back(rn);
     rep.tolerance = st.newton_tolerance * m_force_scale;
     rep.active_contacts = contact.active;
+    contact_active_or_open = !contact.candidates.empty();
     if (is_converged(it, rn, previous, rep.tolerance, contact.worst_gap, gap_tol)) {
       rep.converged = true;
       break;
@@ -76,8 +82,42 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
   }
 
   store_contact_forces();
+  if (!rep.converged && contact_active_or_open) fail_contact_not_converged(rep, when, gap_tol);
   if (!rep.converged) fail_not_converged(rep, when);
   return rep;
+}
+
+// A step with contact that does not converge: which contacts (slave body and node, master body
+// and feature, gap, multiplier), the residual history's tail, and what to change.
+void Solver::fail_contact_not_converged(const StepReport& rep, const std::string& when,
+                                        double gap_tol) const {
+  std::string list;
+  int shown = 0;
+  for (const auto& s : m_contact.slots()) {
+    if (!s.active && !(s.gap < 0)) continue;
+    if (shown++ >= kContactsNamed) continue;
+    const std::string master =
+        s.master_body < 0 ? fmt::format("plane {}", s.plane)
+        : s.m1 < 0 ? fmt::format("body '{}' node {}", m_bodies[s.master_body]->spec.name, s.m0)
+                   : fmt::format("body '{}' edge ({}, {}) at {:.3g}",
+                                 m_bodies[s.master_body]->spec.name, s.m0, s.m1, s.xi);
+    list += fmt::format("\n  body '{}' node {} against {}: gap {:.3e}, multiplier {:.3e}{}",
+                        m_bodies[s.slave_body]->spec.name, s.slave_node, master, s.gap,
+                        s.lambda, s.active ? "" : " (inactive, penetrating)");
+  }
+  std::string history;
+  const auto& r = rep.residuals;
+  for (std::size_t k = r.size() > kResidualsNamed ? r.size() - kResidualsNamed : 0; k < r.size(); ++k)
+    history += fmt::format("{}{:.3e}", history.empty() ? "" : ", ", r[k]);
+  fsi::fail(
+      "Newton did not converge in {} iterations at {} with contact: residual {:.3e} (the last "
+      "iterations: {}), tolerance {:.3e}, accepted gap {:.3e}; {} active "
+      "and penetrating contacts{}{}\nChange: solid.newton_max_iterations (now {}), "
+      "solid.contact_tolerance (now {:g}, relative to the smallest surface edge), or a smaller "
+      "[time] dt",
+      rep.iterations, when, r.back(), history, rep.tolerance, gap_tol, shown, list,
+      shown > kContactsNamed ? fmt::format("\n  ... and {} more", shown - kContactsNamed) : "",
+      m_model.settings.newton_max_iterations, m_model.settings.contact_tolerance);
 }
 
 // The residual and tangent at the iterate. An iterate that leaves the material's domain

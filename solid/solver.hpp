@@ -190,6 +190,8 @@ class Solver {
   [[noreturn]] void fail_non_finite_residual(std::pair<int, int> inverted,
                                              const std::string& when) const;
   [[noreturn]] void fail_not_converged(const StepReport& rep, const std::string& when) const;
+  [[noreturn]] void fail_contact_not_converged(const StepReport& rep, const std::string& when,
+                                               double gap_tol) const;
 
   Model m_model;
   std::vector<std::unique_ptr<Body>> m_bodies;

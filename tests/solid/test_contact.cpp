@@ -175,3 +175,55 @@ TEST_CASE("the segment gap Hessian is the derivative of the gap gradient", "[con
       CHECK((gp[r] - gm[r]) / (2 * h) == Approx(H[6 * r + c]).margin(1e-7));
   }
 }
+
+// Two blocks of equal width stacked so that they touch along y = 0.5 at t = 0 (as the vocal
+// folds at h = 0: mirrored meshes, coincident nodes, the face at the edge of each body's
+// bounding box), each fixed at its far face and thrown at the other, then apart. Two failures
+// of Newton at contact onset are reproduced here: (1) a node just outside the master's box
+// became a candidate without its closest feature, and its row of B read the equations of node
+// -1 (written out of bounds into the other rows); (2) the coincident corner nodes are as close
+// to the master's top edge as to its side edge, the tie flipped with round-off between
+// iterations, and with it the normal. Either stalled Newton at its iteration cap.
+TEST_CASE("mirrored blocks touching at t = 0: Newton converges through impact and release",
+          "[contact][dynamic]") {
+  for (bool moving_apart : {false, true})
+    for (bool two_way : {true, false}) {
+      INFO((moving_apart ? "thrown apart" : "thrown together") << ", two-way " << two_way);
+      Model model;
+      model.settings.newton_tolerance = 1e-10;
+      model.settings.newton_max_iterations = 30;
+      const double v = moving_apart ? 0.3 : -0.3;
+      BodySpec a;
+      a.name = "lower";
+      a.mesh = rectangle_mesh(0, 0, 0.4, 0.5, 8, 10, Diagonals::right);
+      a.materials = {Material::from_young(MaterialModel::saint_venant_kirchhoff, 1e5, 0.2, 1000)};
+      a.constraints = {fixed("bottom")};
+      a.initial_velocity = {0, -v};
+      BodySpec b = a;
+      b.name = "upper";
+      b.mesh = rectangle_mesh(0, 0.5, 0.4, 0.5, 8, 10, Diagonals::right);
+      b.constraints = {fixed("top")};
+      b.initial_velocity = {0, v};
+      model.bodies = {a, b};
+      ContactPair p;
+      p.slave = 0;
+      p.master = 1;
+      p.two_way = two_way;
+      model.contacts = {p};
+      Solver s(model);
+      int contact_steps = 0, worst_iterations = 0;
+      double worst_gap = 0;
+      for (int k = 0; k < 1200; ++k) {
+        StepReport rep;
+        REQUIRE_NOTHROW(rep = s.advance(2e-4));
+        worst_iterations = std::max(worst_iterations, rep.iterations);
+        worst_gap = std::min(worst_gap, s.min_contact_gap());
+        if (rep.active_contacts > 0) ++contact_steps;
+      }
+      INFO("contact steps " << contact_steps << ", most Newton iterations " << worst_iterations);
+      CHECK(contact_steps > 0);
+      CHECK(contact_steps < 1200);       // they also come apart
+      CHECK(worst_iterations <= 8);
+      CHECK(worst_gap >= -1e-8 * 0.4);   // no penetration
+    }
+}
