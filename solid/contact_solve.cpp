@@ -134,10 +134,7 @@ Solver::ContactLinearisation Solver::linearise_contact(
     } else {
       con.worst_gap = std::max(con.worst_gap, -s.gap);
     }
-    // A slot outside its master's box has a lower bound of its gap but no master feature
-    // (ContactSet::detect_slot): no row to build, and it cannot touch within this iteration.
-    const bool has_feature = s.master_body < 0 || s.m0 >= 0;
-    if (has_feature && (s.active || s.gap < m_bodies[s.slave_body]->min_edge))
+    if (s.active || s.gap < m_bodies[s.slave_body]->min_edge)
       con.candidates.push_back(static_cast<int>(&s - slots.data()));
   }
   con.rows.resize(con.candidates.size());
