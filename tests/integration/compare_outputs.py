@@ -84,15 +84,21 @@ def roles_of(bin_dir, scene):
     return re.search(r"^roles: (.*)$", out.stdout, re.M).group(1).split()
 
 
-def run(bin_dir, scene, out):
+def command(bin_dir, scene, args):
+    """The mpirun line of the programs a scene needs (fsi-plan), each given `args`."""
     cmd = ["mpirun", "--oversubscribe"]
     if os.geteuid() == 0:
         cmd.append("--allow-run-as-root")
     for k, p in enumerate(roles_of(bin_dir, scene)):
         if k:
             cmd.append(":")
-        cmd += ["-n", "1", os.path.join(bin_dir, p), scene, "--out-dir", out, "--overwrite"]
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
+        cmd += ["-n", "1", os.path.join(bin_dir, p), scene] + list(args)
+    return cmd
+
+
+def run(bin_dir, scene, out):
+    r = subprocess.run(command(bin_dir, scene, ["--out-dir", out, "--overwrite"]), capture_output=True,
+                       text=True, timeout=900)
     if r.returncode != 0:
         sys.exit(f"compare_outputs: the run of {scene} with {bin_dir} failed (exit {r.returncode}):\n"
                  f"{r.stderr[-3000:]}")

@@ -5,7 +5,10 @@ device" naming the file, exit non-zero, and leave every step group of fluid.h5 r
 
   disk_full.py --work DIR --scene disk_full.toml --fluid FLUID -- MPIEXEC...
 """
-import argparse, glob, os, subprocess, sys
+import argparse
+import os
+import subprocess
+import sys
 
 import h5py
 
@@ -33,7 +36,7 @@ def main():
         print(text)
         if r.returncode == 0:
             problems.append("exit code 0 on a full disk")
-        if f"no space left on device: writing" not in text or f"{out}/fluid.h5" not in text:
+        if "no space left on device: writing" not in text or f"{out}/fluid.h5" not in text:
             problems.append("no 'no space left on device' naming fluid.h5")
         with h5py.File(os.path.join(out, "fluid.h5"), "r") as h:
             groups = [k for k in h if k.startswith("step_")]

@@ -29,7 +29,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from compare_outputs import compare_dirs, roles_of  # noqa: E402
+from compare_outputs import command, compare_dirs  # noqa: E402
 
 
 def write_scene(scene, t_end, extra, tag, checkpoint_interval=None):
@@ -46,17 +46,6 @@ def write_scene(scene, t_end, extra, tag, checkpoint_interval=None):
     with open(path, "w") as f:
         f.write(text + "\n" + extra + "\n")
     return path
-
-
-def command(bin_dir, scene, args):
-    cmd = ["mpirun", "--oversubscribe"]
-    if os.geteuid() == 0:
-        cmd.append("--allow-run-as-root")
-    for k, p in enumerate(roles_of(bin_dir, scene)):
-        if k:
-            cmd.append(":")
-        cmd += ["-n", "1", os.path.join(bin_dir, p), scene] + args
-    return cmd
 
 
 def run(bin_dir, scene, args, what):

@@ -10,14 +10,13 @@ and every numeric dataset of its .h5 files, value for value (NaN equal to NaN). 
 first difference, or when a run fails or a folder holds nothing to compare.
 """
 import argparse
-import glob
 import json
 import os
 import subprocess
 import sys
 
-import h5py
-import numpy as np
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from compare_outputs import compare_dirs  # noqa: E402
 
 
 def run(mpiexec, programs, bin_dir, scene, out, cwd):
@@ -29,14 +28,6 @@ def run(mpiexec, programs, bin_dir, scene, out, cwd):
     r = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=300)
     if r.returncode != 0:
         sys.exit(f"same_runs: the run of {scene} failed (exit {r.returncode}):\n{r.stderr[-2000:]}")
-
-
-def h5_datasets(path):
-    out = {}
-    with h5py.File(path, "r") as f:
-        f.visititems(lambda name, obj: out.__setitem__(name, obj[()])
-                     if isinstance(obj, h5py.Dataset) and obj.dtype.kind in "fiu" else None)
-    return out
 
 
 def main():
@@ -56,23 +47,9 @@ def main():
     run(a.mpiexec, programs, a.bin, a.scene, first, a.cwd)
     run(a.mpiexec, programs, a.bin, plain, second, a.cwd)
 
-    compared = 0
-    for path in sorted(glob.glob(os.path.join(first, "*.csv"))):
-        other = os.path.join(second, os.path.basename(path))
-        if open(path, "rb").read() != open(other, "rb").read():
-            sys.exit(f"same_runs: {os.path.basename(path)} differs")
-        compared += 1
-    for path in sorted(glob.glob(os.path.join(first, "*.h5"))):
-        d1 = h5_datasets(path)
-        d2 = h5_datasets(os.path.join(second, os.path.basename(path)))
-        if sorted(d1) != sorted(d2):
-            sys.exit(f"same_runs: {os.path.basename(path)} holds other datasets")
-        for name, v in d1.items():
-            if not np.array_equal(v, d2[name], equal_nan=v.dtype.kind == "f"):
-                sys.exit(f"same_runs: {os.path.basename(path)}:{name} differs")
-            compared += 1
-    if compared == 0:
-        sys.exit("same_runs: nothing to compare")
+    diff, compared = compare_dirs(first, second)
+    if diff:
+        sys.exit(f"same_runs: {diff}")
     with open(os.path.join(first, "summary.json")) as f:
         summary = json.load(f)
     for p in programs:
