@@ -123,6 +123,7 @@ void Coupler::begin_solid_step(long n) {
 // The fluid's step (or, in iteration k > 0, its forcing f_s = ρ_f α (ū_s − ũ)/Δt and projection
 // again from the same predictor ũ).
 void Coupler::fluid(long n) {
+  if (m_surface && m_sb.iteration == 0) request_surface_samples();
   if (has(Role::fluid)) exchange(Role::fluid, m_fluid_in, m_fluid_out, n);
 }
 
@@ -255,6 +256,7 @@ void Coupler::commit(long n) {
     m_log->root_loads(m_solid_in.force, m_fiber.root_load, m_log_poses);
   }
   write_force_probes(n, m_start, m_reaction);
+  write_surface_probes(n);
   if (has(Role::solid)) check_growth(n + 1);
 }
 

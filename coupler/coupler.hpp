@@ -19,6 +19,7 @@
 #include "protocol.hpp"
 #include "runtime.hpp"
 #include "summary.hpp"
+#include "surface.hpp"
 
 namespace coupler {
 
@@ -89,6 +90,10 @@ class Coupler {
   void setup_force_probes();
   void write_force_probes(long step, const proto::SolidState& start,
                           const std::vector<std::vector<double>>& reaction);
+  // Surface probes (surface_probes.cpp; the method in surface.hpp).
+  void setup_surface_probes();
+  void request_surface_samples();
+  void write_surface_probes(long step);
 
   // Where an attached fiber's root sits: surface edge `edge` (node a -> node b) of body `body`, at
   // parameter s along it. body < 0: the fiber is not attached to a body.
@@ -132,6 +137,11 @@ class Coupler {
   std::vector<std::array<double, 2>> m_body_force;  // per body: hydrodynamic force of this step
   std::unique_ptr<fsi::ProbeCsv> m_probes;
   std::vector<double> m_probe_row;
+  // [[coupler.surface_probe]]: as read, the probes on their bodies (null without), the CSV.
+  std::vector<SurfaceProbeSpec> m_surface_specs;
+  std::unique_ptr<SurfaceProbes> m_surface;
+  std::unique_ptr<fsi::ProbeCsv> m_surface_csv;
+  std::vector<double> m_surface_row;
   std::unique_ptr<fsi::Progress> m_progress;
   // [coupler.diagnostics]: the exchange log (null when off) and its settings.
   std::unique_ptr<ExchangeLog> m_log;

@@ -32,6 +32,14 @@ Coupler::Coupler(fsi::Runtime& rt) : m_rt(rt) {
       f.finish();
       m_force_groups.push_back(g);
     }
+    for (const auto& f : c->tables("surface_probe")) {
+      SurfaceProbeSpec sp;
+      sp.name = f.string("name");
+      sp.body = f.string("body", "");
+      sp.point = f.vec2("point");
+      f.finish();
+      m_surface_specs.push_back(sp);
+    }
     m_kappa_given = c->has("kappa");
     if (m_kappa_given) m_kappa = c->positive("kappa");
     m_kappa_gain = c->in_range("kappa_gain", 0.0, kMaxKappaGain, true, m_kappa_gain);
@@ -135,6 +143,7 @@ void Coupler::setup() {
   m_solid_in.force.assign(bodies.size(), {});
   if (m_ib) warn_marker_spacing();
   setup_force_probes();
+  setup_surface_probes();
   if (m_accel)
     m_iter_csv = std::make_unique<fsi::ProbeCsv>(fsi::output_csv(
         m_rt, m_rt.out_dir() / "coupler_iterations.csv",

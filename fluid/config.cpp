@@ -263,6 +263,15 @@ Config read_config(const fsi::SceneTable& f, double dt) {
       for (int s = 0; s < 4; ++s)
         if (ws == kSideNames[s]) c.wall_shear = {Side(s)};
     }
+    // Only when given: a scene without it keeps its effective scene as it was.
+    if (d->has("flow_rate")) {
+      c.flow_rate = d->numbers("flow_rate");
+      const double lo = c.x.origin, hi = c.x.origin + c.x.length;
+      for (std::size_t k = 0; k < c.flow_rate.size(); ++k)
+        if (!(c.flow_rate[k] >= lo && c.flow_rate[k] <= hi))
+          d->fail("flow_rate", fmt::format("section {} at x = {} is outside the domain's x range "
+                                           "[{}, {}]", k, c.flow_rate[k], lo, hi));
+    }
     d->finish();
   }
   if (auto h = f.optional_table("health")) {

@@ -65,6 +65,7 @@ struct Config {
   Initial initial;
   std::vector<Probe> probes;
   std::vector<Side> wall_shear;  // sides along which tau_w (Eq. 30) is written
+  std::vector<double> flow_rate;  // x of the vertical sections whose volume flux is written
   double cfl_max = 1.0;          // health: stop above this CFL number
   double divergence_max = 1e-6;  // health: stop when max |div u| dt exceeds this (after growth)
   long health_every = 10;        // steps between divergence checks

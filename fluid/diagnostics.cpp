@@ -172,6 +172,22 @@ std::vector<double> wall_shear(const Solver& s, Side side, std::vector<double>* 
   return tau;
 }
 
+int nearest_u_column(const Solver& s, double x) {
+  const Axis& X = s.grid().x();
+  const int n = X.n();
+  int best = 0;
+  for (int i = 1; i <= n; ++i)
+    if (std::abs(X.face(i) - x) < std::abs(X.face(best) - x)) best = i;
+  return X.periodic() && best == n ? 0 : best;
+}
+
+double flow_rate(const Solver& s, int i) {
+  const Axis& Y = s.grid().y();
+  double q = 0;
+  for (int j = 0; j < s.grid().ny(); ++j) q += s.u()(i, j) * Y.width(j);
+  return q;
+}
+
 void vorticity(const Solver& s, std::vector<double>& out) {
   const Grid& g = s.grid();
   const int nx = g.nx(), ny = g.ny();

@@ -35,6 +35,14 @@ double sample(const Solver& s, int q, double x, double y);
 // value and the first two interior values. Returns one value per tangential cell position
 // (positions: the face coordinates of the tangential component along the wall).
 std::vector<double> wall_shear(const Solver& s, Side side, std::vector<double>* position = nullptr);
+// The u-face column nearest to x: the section a flow_rate line x = x0 is measured on (ties go to
+// the lower index; on a periodic x the last face, at the domain's end, is face 0).
+int nearest_u_column(const Solver& s, double x);
+// The volume flux per unit depth through u-face column i, exact on the MAC grid:
+//   Q_i = sum_j u(i, j) w_y(j)
+// (the flux the discrete divergence balances, so the same in every column of a steady flow
+// without sources; inside an immersed body it counts the forced velocity, i.e. the body's).
+double flow_rate(const Solver& s, int i);
 // Vorticity dv/dx - du/dy at the cell centres (nx * ny, i fastest): mean of the four corners.
 void vorticity(const Solver& s, std::vector<double>& out);
 // Cell-centred velocity (nx * ny, i fastest).

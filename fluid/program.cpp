@@ -44,6 +44,15 @@ FluidProgram::FluidProgram(fsi::Runtime& rt)
                                      fsi::probe_columns(names, {"ux", "uy", "p"})));
     m_row.resize(3 * names.size());
   }
+  if (!m_cfg.flow_rate.empty()) {
+    std::vector<std::string> cols;
+    for (std::size_t k = 0; k < m_cfg.flow_rate.size(); ++k) {
+      m_flow_columns.push_back(nearest_u_column(*m_solver, m_cfg.flow_rate[k]));
+      cols.push_back(fmt::format("Q{}", k));
+    }
+    m_flow.emplace(fsi::output_csv(rt, rt.out_dir() / "fluid_flow_rate.csv", cols));
+    m_flow_row.resize(cols.size());
+  }
 }
 
 fsi::proto::GridInfo FluidProgram::grid_info() const {
@@ -177,7 +186,54 @@ void FluidProgram::output(long step, double t, bool fields) {
     }
     m_probes->write(t, m_row);
   }
+  if (m_flow) write_flow_rate(t);
   if (fields) write_fields(step, t);
+}
+
+// One row of fluid_flow_rate.csv: Q_k = sum_j u(i_k, j) w_y(j) at each section's face column.
+void FluidProgram::write_flow_rate(double t) {
+  for (std::size_t k = 0; k < m_flow_columns.size(); ++k)
+    m_flow_row[k] = flow_rate(*m_solver, m_flow_columns[k]);
+  m_flow->write(t, m_flow_row);
+  m_flow_times.push_back(t);
+  m_flow_values.insert(m_flow_values.end(), m_flow_row.begin(), m_flow_row.end());
+}
+
+// Per section: where it is measured, and over this run's steps (since the start or the restart)
+// the mean, min, max and the fluctuation amplitude (max - min) / 2; with an oscillating forcing
+// also the amplitude over the last forcing period (the periodic state's, start-up excluded).
+nlohmann::json FluidProgram::flow_rate_report() const {
+  nlohmann::json out = nlohmann::json::array();
+  const std::size_t n = m_flow_columns.size(), steps = m_flow_times.size();
+  const bool oscillating =
+      m_cfg.period > 0 && (m_cfg.oscillating[0] != 0 || m_cfg.oscillating[1] != 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    nlohmann::json j;
+    j["x"] = m_cfg.flow_rate[k];
+    j["face_column"] = m_flow_columns[k];
+    j["face_x"] = m_solver->grid().x().face(m_flow_columns[k]);
+    if (steps > 0) {
+      double lo = m_flow_values[k], hi = lo, sum = 0, plo = lo, phi = lo;
+      bool any_period = false;
+      const double t_from = m_flow_times.back() - m_cfg.period;
+      for (std::size_t s = 0; s < steps; ++s) {
+        const double q = m_flow_values[s * n + k];
+        lo = std::min(lo, q), hi = std::max(hi, q), sum += q;
+        if (oscillating && m_flow_times[s] >= t_from) {
+          if (!any_period) plo = phi = q, any_period = true;
+          plo = std::min(plo, q), phi = std::max(phi, q);
+        }
+      }
+      j["mean"] = sum / double(steps);
+      j["min"] = lo;
+      j["max"] = hi;
+      j["amplitude"] = 0.5 * (hi - lo);
+      if (oscillating && m_flow_times.back() - m_flow_times.front() >= m_cfg.period)
+        j["amplitude_last_period"] = 0.5 * (phi - plo);
+    }
+    out.push_back(j);
+  }
+  return out;
 }
 
 // The solver's state, and the health check's (the diagnostics the coupler is sent).
@@ -212,6 +268,7 @@ nlohmann::json FluidProgram::report() const {
   j["ns_per_cell_step"] = 1e9 * total / (cells * steps);
   j["max_divergence"] = max_divergence(*m_solver).value;
   j["kinetic_energy"] = kinetic_energy(*m_solver);
+  if (m_flow) j["flow_rate"] = flow_rate_report();
   return j;
 }
 

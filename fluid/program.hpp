@@ -30,6 +30,8 @@ class FluidProgram : public fsi::FluidPort {
 
  private:
   void write_fields(long step, double t);
+  void write_flow_rate(double t);
+  nlohmann::json flow_rate_report() const;
   // Health: NaN/Inf, CFL above its limit, divergence growth. Writes the state, then throws.
   void check_health(long step, double t, double dt);
 
@@ -40,6 +42,11 @@ class FluidProgram : public fsi::FluidPort {
   std::optional<fsi::XdmfWriter> m_xdmf;
   std::optional<fsi::ProbeCsv> m_probes;
   std::vector<double> m_row, m_w1, m_w2;
+  // Flow-rate sections ([fluid.diagnostics] flow_rate): their u-face columns, the CSV, and the
+  // times and values of this run's steps (for the report's mean and fluctuation amplitude).
+  std::vector<int> m_flow_columns;
+  std::optional<fsi::ProbeCsv> m_flow;
+  std::vector<double> m_flow_row, m_flow_times, m_flow_values;
   CouplingOut m_out;
   double m_cfl = 0, m_div = 0, m_div_first = -1;
   double m_energy = 0;  // kinetic energy, refreshed with the divergence every health.every steps
