@@ -159,16 +159,21 @@ std::vector<std::vector<double>> read_vectors(const H5File& h5, const std::strin
 
 double restart_time(const Runtime& rt) { return step_time(rt.settings(), rt.first_step()); }
 
-double restart_fields_time(const Runtime& rt) {
+namespace {
+// The last step whose fields a restarted run keeps: the restart step when the resumed scene
+// outputs it, else the one before (a run that ended there wrote it as its last).
+long last_kept_fields_step(const Runtime& rt) {
   const long n = rt.first_step();
-  return step_time(rt.settings(), is_output_step(rt.settings(), n) ? n : n - 1);
+  return is_output_step(rt.settings(), n) ? n : n - 1;
 }
+}  // namespace
+
+double restart_fields_time(const Runtime& rt) { return step_time(rt.settings(), last_kept_fields_step(rt)); }
 
 H5File output_h5(const Runtime& rt, const std::filesystem::path& path) {
   if (!rt.restart_step() || !std::filesystem::exists(path)) return H5File(path, H5File::Mode::truncate);
   H5File h5(path, H5File::Mode::read_write);
-  const long n = *rt.restart_step();
-  const long keep = is_output_step(rt.settings(), n) ? n : n - 1;
+  const long keep = last_kept_fields_step(rt);
   for (const std::string& name : h5.children("/"))
     if (folder_step(name) > keep) h5.remove("/" + name);
   return h5;
