@@ -173,8 +173,9 @@ run() {
 }
 
 # Open MPI's lines after every MPI_Abort that tell nothing of the cause (its bookkeeping of the
-# processes it killed) and mislead; every other line of mpirun's stays visible.
-MPI_NOISE='ORTE_ERROR_LOG: (Out of resource|Data unpack would read past end of buffer)'
+# processes it killed) and mislead: the known ones always, and any ORTE_ERROR_LOG line once a
+# program has reported its error; every other line of mpirun's stays visible.
+MPI_NOISE='ORTE_ERROR_LOG: (Out of resource|Data unpack (would read past end of buffer|had inadequate space))'
 
 # launch MPIRUN ARGS...: run the job, stderr filtered of MPI_NOISE (the programs' "[role] ERROR:"
 # lines kept aside for the summary), and wait for it. SIGTERM, SIGINT or SIGHUP to the launcher
@@ -191,7 +192,8 @@ launch() {
   mkfifo "$fifo"
   awk -v errs="$errs" -v noise="$MPI_NOISE" '
     $0 ~ noise { next }
-    /^\[(fluid|solid|fiber|coupler)\] ERROR: / { print >> errs; fflush(errs) }
+    failed && /ORTE_ERROR_LOG: / { next }
+    /^\[(fluid|solid|fiber|coupler)\] ERROR: / { failed = 1; print >> errs; fflush(errs) }
     { print; fflush() }' <"$fifo" >&2 &
   fpid=$!
   FSI_LAUNCHER_PID=$$ "$@" 2>"$fifo" &
