@@ -121,24 +121,28 @@ void StepBegin::unpack(Reader& r) {
 
 void FluidInput::pack(Writer& w) const {
   put(w, solid_u), put(w, solid_v), put(w, force_u), put(w, force_v);
-  w.put(sample_u), w.put(sample_v);
+  w.put(sample_u), w.put(sample_v), w.put(sample_p);
 }
 void FluidInput::unpack(Reader& r) {
   get(r, solid_u), get(r, solid_v), get(r, force_u), get(r, force_v);
-  r.get(sample_u), r.get(sample_v);
+  r.get(sample_u), r.get(sample_v), r.get(sample_p);
 }
 
 void FluidOutput::pack(Writer& w) const {
-  w.put(fs_u), w.put(fs_v), w.put(u_sample), w.put(v_sample);
+  w.put(fs_u), w.put(fs_v), w.put(u_sample), w.put(v_sample), w.put(p_sample);
   w.put(cfl), w.put(max_div), w.put(kinetic_energy);
 }
 void FluidOutput::unpack(Reader& r) {
-  r.get(fs_u), r.get(fs_v), r.get(u_sample), r.get(v_sample);
+  r.get(fs_u), r.get(fs_v), r.get(u_sample), r.get(v_sample), r.get(p_sample);
   r.get(cfl), r.get(max_div), r.get(kinetic_energy);
 }
 
-void SolidInput::pack(Writer& w) const { put_list(w, force), put_list(w, velocity); }
-void SolidInput::unpack(Reader& r) { get_list(r, force), get_list(r, velocity); }
+void SolidInput::pack(Writer& w) const {
+  put_list(w, force), put_list(w, velocity), put_list(w, root_mass);
+}
+void SolidInput::unpack(Reader& r) {
+  get_list(r, force), get_list(r, velocity), get_list(r, root_mass);
+}
 
 void SolidState::pack(Writer& w) const { w.put(time), put_list(w, x), put_list(w, v); }
 void SolidState::unpack(Reader& r) { r.get(time), get_list(r, x), get_list(r, v); }
@@ -147,10 +151,12 @@ void FiberInput::pack(Writer& w) const { put_list(w, force), put_list(w, root_po
 void FiberInput::unpack(Reader& r) { get_list(r, force), get_list(r, root_pose); }
 
 void FiberState::pack(Writer& w) const {
-  w.put(time), put_list(w, x), put_list(w, x_old), w.put(root_load);
+  w.put(time), put_list(w, x), put_list(w, x_old), w.put(root_load), w.put(root_mass),
+      w.put(root_accel);
 }
 void FiberState::unpack(Reader& r) {
-  r.get(time), get_list(r, x), get_list(r, x_old), r.get(root_load);
+  r.get(time), get_list(r, x), get_list(r, x_old), r.get(root_load), r.get(root_mass),
+      r.get(root_accel);
 }
 
 }  // namespace fsi::proto

@@ -18,7 +18,7 @@
 namespace fsi::proto {
 
 // Bump on any change of a message's layout or of the message order.
-inline constexpr std::int32_t kVersion = 6;
+inline constexpr std::int32_t kVersion = 7;
 inline constexpr std::uint32_t kMagic = 0x4d495346;  // "FSIM"
 
 // 64-bit FNV-1a of bytes: the handshake's scene and output-options hashes (PROTOCOL.md,
@@ -218,6 +218,7 @@ struct FluidInput {  // coupler -> fluid, every step
   FaceSolid solid_u, solid_v;   // immersed solid: alpha, mean solid velocity
   FaceForce force_u, force_v;   // fibers' spread force f_f, applied in the predictor
   std::vector<std::int32_t> sample_u, sample_v;  // faces whose u^(n+1) the coupler wants back
+  std::vector<std::int32_t> sample_p;  // cells (i + nx j) whose p^(n+1) it wants (version 7)
   void pack(Writer& w) const;
   void unpack(Reader& r);
 };
@@ -228,6 +229,7 @@ struct FluidOutput {  // fluid -> coupler, every step
   // volume ON THE FLUID.
   std::vector<double> fs_u, fs_v;
   std::vector<double> u_sample, v_sample;  // u^(n+1) on sample_u / sample_v
+  std::vector<double> p_sample;            // p^(n+1) in sample_p's cells (since version 7)
   double cfl = 0, max_div = 0, kinetic_energy = 0;
   void pack(Writer& w) const;
   void unpack(Reader& r);
@@ -243,6 +245,11 @@ struct SolidInput {  // coupler -> solid, every step
   // estimate 2v^n - v^(n-1) at iteration 0, the coupler's accelerated estimate after). The reaction depends on them as dF/dv ~ -M_f/dt (M_f the
   // mass matrix of the fluid inside the body); a solid may use them to linearise it.
   std::vector<std::vector<double>> velocity;
+  // Since version 7, per body: the fibers' root inertia at the nodes of the edges that hold them,
+  // (m_xx, m_xy, m_yy) per node [3 per node], or empty (no rooted fiber on the body). The root
+  // loads in `force` then come without that inertia: the solid adds -m a^(n+1) at each node,
+  // a its own acceleration of the node over this step (PROTOCOL.md, "Fiber roots").
+  std::vector<std::vector<double>> root_mass;
   void pack(Writer& w) const;
   void unpack(Reader& r);
 };
@@ -272,6 +279,10 @@ struct FiberState {  // fiber -> coupler, at set-up and after every step
   std::vector<std::vector<double>> x, x_old;  // per fiber: X^n, X^(n-1)
   // per fiber: load the fiber exerts ON ITS SUPPORT at the root: (fx, fy, moment about the root)
   std::vector<double> root_load;
+  // Since version 7, per fiber: the root load's response to the root's acceleration a,
+  // root_load ~ root_load_0 - mass a: (m_xx, m_xy, m_yy) [3 per fiber], and the acceleration
+  // (a_x, a_y) it was taken at [2 per fiber]; zeros for fibers without a supported root.
+  std::vector<double> root_mass, root_accel;
   void pack(Writer& w) const;
   void unpack(Reader& r);
 };

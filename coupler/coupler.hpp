@@ -86,6 +86,7 @@ class Coupler {
   void resolve_roots();
   void root_poses(const proto::SolidState& state, std::vector<std::vector<double>>& poses) const;
   void add_root_loads(const proto::SolidState& state);
+  std::vector<double> root_loads_without_inertia() const;
   // Force probes (probes.cpp).
   void setup_force_probes();
   void write_force_probes(long step, const proto::SolidState& start,

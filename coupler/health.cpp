@@ -111,13 +111,32 @@ void Coupler::check_growth(long step) {
     m_growing[b] = grew ? m_growing[b] + 1 : 0;
     m_energy[b] = e;
     vo = v;
-    if (m_growing[b] >= m_growth_steps)
-      fsi::fail("body '{}' is unstable at step {}: its kinetic energy per unit density "
-                "1/2 int |v|^2 dA = {:.3g} grew by more than a factor {} and its velocity "
-                "reversed in each of the last {} steps: the explicit coupling cannot hold this "
-                "time.dt = {} (lower it, make the body heavier, or turn on coupled iterations, "
-                "[coupler.iterations] max > 1)",
-                body.name, step, e, m_growth_factor, m_growth_steps, m_rt.settings().dt);
+    if (m_growing[b] < m_growth_steps) continue;
+    // Fibers rooted on the body: their root loads (roots.cpp) are the other explicit exchange.
+    std::string rooted;
+    int n_rooted = 0;
+    bool has_mass = false;
+    for (std::size_t k = 0; k < m_roots.size(); ++k) {
+      if (m_roots[k].body != static_cast<int>(b)) continue;
+      if (n_rooted++ < 4) rooted += fmt::format("{}'{}'", rooted.empty() ? "" : ", ", m_layout.fibers[k].name);
+      for (int i = 0; i < 3 && 3 * k + i < m_fiber.root_mass.size(); ++i)
+        has_mass = has_mass || m_fiber.root_mass[3 * k + i] != 0;
+    }
+    if (n_rooted > 4) rooted += fmt::format(" and {} more", n_rooted - 4);
+    const std::string roots =
+        n_rooted == 0 ? ""
+        : has_mass
+            ? fmt::format("; it holds the roots of fibers {}, whose inertia it takes within the "
+                          "step: check their root loads (fiber_loads.csv)", rooted)
+            : fmt::format("; it holds the roots of fibers {}, whose fiber program sends no root "
+                          "mass: their inertia reaches the body one step late, which holds only "
+                          "while each fiber is lighter than the nodes that hold it", rooted);
+    fsi::fail("body '{}' is unstable at step {}: its kinetic energy per unit density "
+              "1/2 int |v|^2 dA = {:.3g} grew by more than a factor {} and its velocity "
+              "reversed in each of the last {} steps: the explicit coupling cannot hold this "
+              "time.dt = {} (lower it, make the body heavier, or turn on coupled iterations, "
+              "[coupler.iterations] max > 1){}",
+              body.name, step, e, m_growth_factor, m_growth_steps, m_rt.settings().dt, roots);
   }
 }
 

@@ -68,15 +68,23 @@ void Coupler::root_poses(const proto::SolidState& state,
 
 // The fiber's load on its support (force F, moment M at the root point p) as equivalent nodal
 // forces on the edge a -> b that holds it (paper Sec. 3.2.3, Fig. 2):
-//   f_a = (1 − s) F − q n,  f_b = s F + q n,  n = (−t_y, t_x), q = M / L,
-// with t the edge's unit tangent and L its length: the resultant is F, and the moment about p is
-// (1 − s)(x_a − p) × F + s (x_b − p) × F + q (x_b − x_a) × n = 0 + q L = M, exactly.
+//   f_a = (1 − s) F' − q n,  f_b = s F' + q n,  n = (−t_y, t_x), q = M / L,
+// with t the edge's unit tangent and L its length: the resultant is F', and the moment about p is
+// (1 − s)(x_a − p) × F' + s (x_b − p) × F' + q (x_b − x_a) × n = 0 + q L = M, exactly.
+// The fiber's inertia goes to the solid implicitly: the fiber reports its load's response to the
+// root's acceleration, F ~ F_0 − m a (m = root_mass), and the acceleration a* it took F at. The
+// solid gets F' = F + m a* (the load without that inertia) and the root mass lumped on the edge's
+// nodes, (1 − s) m at a and s m at b, to which it adds −m a^(n+1) with its own acceleration of the
+// step (PROTOCOL.md, "Fiber roots"). Sent one step late, the inertia −m a* alone is stable only
+// while m is small against the nodes' mass (the root's acceleration grows by −m / m_node per step).
 void Coupler::add_root_loads(const proto::SolidState& state) {
+  for (auto& m : m_solid_in.root_mass) m.clear();
+  const std::vector<double> load = root_loads_without_inertia();
   for (std::size_t k = 0; k < m_roots.size(); ++k) {
     const Root& r = m_roots[k];
-    if (r.body < 0 || m_fiber.root_load.size() < 3 * (k + 1)) continue;
-    const double fx = m_fiber.root_load[3 * k], fy = m_fiber.root_load[3 * k + 1];
-    const double M = m_fiber.root_load[3 * k + 2];
+    if (r.body < 0 || load.size() < 3 * (k + 1)) continue;
+    if (m_meshes.bodies[r.body].kind != proto::BodyKind::elastic) continue;
+    const double fx = load[3 * k], fy = load[3 * k + 1], M = load[3 * k + 2];
     const auto& x = state.x[r.body];
     const double dx = x[2 * r.b] - x[2 * r.a], dy = x[2 * r.b + 1] - x[2 * r.a + 1];
     const double len = std::hypot(dx, dy);
@@ -87,7 +95,28 @@ void Coupler::add_root_loads(const proto::SolidState& state) {
     f[2 * r.a + 1] += (1 - r.s) * fy - q * ny;
     f[2 * r.b] += r.s * fx + q * nx;
     f[2 * r.b + 1] += r.s * fy + q * ny;
+    if (m_fiber.root_mass.size() < 3 * (k + 1)) continue;
+    if (m_solid_in.root_mass.size() < m_meshes.bodies.size())
+      m_solid_in.root_mass.resize(m_meshes.bodies.size());
+    auto& m = m_solid_in.root_mass[r.body];
+    if (m.empty()) m.assign(3 * (x.size() / 2), 0.0);
+    for (const auto& [node, w] : {std::pair{r.a, 1 - r.s}, std::pair{r.b, r.s}})
+      for (int i = 0; i < 3; ++i) m[3 * node + i] += w * m_fiber.root_mass[3 * k + i];
   }
+}
+
+// F' = F + m a* per fiber (3 values: force, moment), F the fiber's root load; F where the fiber
+// sent no root mass.
+std::vector<double> Coupler::root_loads_without_inertia() const {
+  std::vector<double> load = m_fiber.root_load;
+  const auto& m = m_fiber.root_mass;
+  const auto& a = m_fiber.root_accel;
+  for (std::size_t k = 0; 3 * k + 2 < load.size(); ++k) {
+    if (m.size() < 3 * (k + 1) || a.size() < 2 * (k + 1)) continue;
+    load[3 * k] += m[3 * k] * a[2 * k] + m[3 * k + 1] * a[2 * k + 1];
+    load[3 * k + 1] += m[3 * k + 1] * a[2 * k] + m[3 * k + 2] * a[2 * k + 1];
+  }
+  return load;
 }
 
 }  // namespace coupler

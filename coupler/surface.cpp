@@ -120,7 +120,9 @@ SurfaceProbes::SurfaceProbes(const proto::GridInfo& g, const proto::BodyMeshes& 
   m_u.y.c = yc;
   m_v.x.c = xc;
   m_v.y.c.assign(g.y_face.begin(), g.y_face.end() - (g.periodic_y ? 1 : 0));
-  for (Family* f : {&m_u, &m_v}) {
+  m_p.x.c = xc;  // cells: i + nx j, at (x_centre[i], y_centre[j])
+  m_p.y.c = yc;
+  for (Family* f : {&m_u, &m_v, &m_p}) {
     f->x.period = g.periodic_x ? lx : 0;
     f->y.period = g.periodic_y ? ly : 0;
     f->value.assign(f->x.c.size() * f->y.c.size(), 0.0);
@@ -131,7 +133,7 @@ SurfaceProbes::SurfaceProbes(const proto::GridInfo& g, const proto::BodyMeshes& 
 std::vector<std::string> SurfaceProbes::columns() const {
   std::vector<std::string> cols;
   for (const auto& p : m_probes)
-    for (const char* q : {"x", "y", "nx", "ny", "tau", "slip"})
+    for (const char* q : {"x", "y", "nx", "ny", "tau", "slip", "p"})
       cols.push_back(fmt::format("{}.{}", p.spec.name, q));
   return cols;
 }
@@ -181,8 +183,8 @@ double SurfaceProbes::interpolate(const Family& f, double x, double y) const {
   for (int k = 0; k < 4; ++k) {
     if (w[k] == 0) continue;
     if (!f.has[idx[k]])
-      fsi::fail("surface probe: face {} of its stencil at ({}, {}) was not sampled by the fluid "
-                "(internal: the request was not sent)",
+      fsi::fail("surface probe: face or cell {} of its stencil at ({}, {}) was not sampled by "
+                "the fluid (internal: the request was not sent)",
                 idx[k], x, y);
     s += w[k] * f.value[idx[k]];
   }
@@ -190,12 +192,15 @@ double SurfaceProbes::interpolate(const Family& f, double x, double y) const {
 }
 
 void SurfaceProbes::add_requests(const proto::SolidState& st, std::vector<std::int32_t>& u_faces,
-                                 std::vector<std::int32_t>& v_faces) {
-  for (auto [f, out] : {std::pair{&m_u, &u_faces}, std::pair{&m_v, &v_faces}}) {
+                                 std::vector<std::int32_t>& v_faces,
+                                 std::vector<std::int32_t>& p_cells) {
+  for (auto [f, out] :
+       {std::pair{&m_u, &u_faces}, std::pair{&m_v, &v_faces}, std::pair{&m_p, &p_cells}}) {
     m_scratch.clear();
+    const int points = f == &m_p ? 2 : kPoints;
     for (const auto& p : m_probes) {
       const Frame fr = frame(p, st);
-      for (int k = 0; k < kPoints; ++k) {
+      for (int k = 0; k < points; ++k) {
         const double d = (kFirst + k) * fr.h;
         std::int32_t idx[4];
         double w[4];
@@ -215,18 +220,20 @@ void SurfaceProbes::add_requests(const proto::SolidState& st, std::vector<std::i
 void SurfaceProbes::evaluate(const proto::SolidState& st, const std::vector<std::int32_t>& u_faces,
                              const std::vector<double>& u,
                              const std::vector<std::int32_t>& v_faces,
-                             const std::vector<double>& v, std::vector<double>& row) {
-  for (auto [f, idx, val] :
-       {std::tuple{&m_u, &u_faces, &u}, std::tuple{&m_v, &v_faces, &v}}) {
+                             const std::vector<double>& v,
+                             const std::vector<std::int32_t>& p_cells,
+                             const std::vector<double>& p, std::vector<double>& row) {
+  for (auto [f, idx, val] : {std::tuple{&m_u, &u_faces, &u}, std::tuple{&m_v, &v_faces, &v},
+                             std::tuple{&m_p, &p_cells, &p}}) {
     if (idx->size() != val->size())
-      fsi::fail("protocol error: {} velocity samples for {} faces", val->size(), idx->size());
+      fsi::fail("protocol error: {} samples for {} faces or cells", val->size(), idx->size());
     std::fill(f->has.begin(), f->has.end(), 0);
     for (std::size_t k = 0; k < idx->size(); ++k) {
       f->value[(*idx)[k]] = (*val)[k];
       f->has[(*idx)[k]] = 1;
     }
   }
-  row.resize(6 * m_probes.size());
+  row.resize(kColumns * m_probes.size());
   for (std::size_t q = 0; q < m_probes.size(); ++q) {
     const Frame fr = frame(m_probes[q], st);
     const double tx = fr.ny, ty = -fr.nx;
@@ -256,10 +263,13 @@ void SurfaceProbes::evaluate(const proto::SolidState& st, const std::vector<std:
       value += l / denom * fk[k];
       slope += dl / denom * fk[k];
     }
-    double* out = &row[6 * q];
+    double* out = &row[kColumns * q];
     out[0] = fr.px, out[1] = fr.py, out[2] = fr.nx, out[3] = fr.ny;
     out[4] = m_mu * (slope + fr.dvn_dt);
     out[5] = value - fr.vt;
+    const double p0 = interpolate(m_p, fr.px + d[0] * fr.nx, fr.py + d[0] * fr.ny);
+    const double p1 = interpolate(m_p, fr.px + d[1] * fr.nx, fr.py + d[1] * fr.ny);
+    out[6] = (d[1] * p0 - d[0] * p1) / (d[1] - d[0]);
   }
 }
 

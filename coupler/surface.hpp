@@ -1,7 +1,8 @@
 // Surface probes ([[coupler.surface_probe]], coupler_surface.csv): the wall shear stress at
-// material points of a body's surface (paper Eq. 30, tau = mu t . (grad u + grad u^T) . n), taken
-// on the fluid side from velocity samples the coupler asks the fluid for (common/PROTOCOL.md,
-// sample_u/sample_v), never from the forced velocity inside the body.
+// material points of a body's surface (paper Eq. 30, tau = mu t . (grad u + grad u^T) . n) and
+// the pressure there, taken on the fluid side from velocity and pressure samples the coupler asks
+// the fluid for (common/PROTOCOL.md, sample_u/sample_v/sample_p), never from the forced velocity
+// inside the body.
 #pragma once
 
 #include <array>
@@ -38,7 +39,11 @@ struct SurfaceProbeSpec {
 //                  one-sided difference to the true wall would divide by a cell;
 //     d(u.n)/dt    along the no-slip surface, that of the body's velocity: −(v_b − v_a).n / L.
 // Also written: the slip u_s = u.t extrapolated to the surface minus the body's v.t there (zero
-// for an exact no-slip wall; it measures where the flow sees the wall).
+// for an exact no-slip wall; it measures where the flow sees the wall), and the pressure
+//   p = (d_1 p(q_0) − d_0 p(q_1)) / (d_1 − d_0),  p(q_k) bilinear in the cell centres,
+// the line through the two nearest fluid points extrapolated to the surface: exact for a linear
+// pressure, O(h^2) where p is smooth (at a no-slip wall dp/dn = mu d^2 u_n/dn^2 stays finite);
+// the pressure inside the body and in the cells the interface cuts is not used.
 class SurfaceProbes {
  public:
   // The probes' edges on the bodies' reference surfaces. An unknown body, or a point farther
@@ -47,20 +52,25 @@ class SurfaceProbes {
   SurfaceProbes(const proto::GridInfo& grid, const proto::BodyMeshes& meshes,
                 std::vector<SurfaceProbeSpec> specs, double viscosity, const std::string& source);
 
-  // Columns of coupler_surface.csv: <name>.x, .y, .nx, .ny, .tau, .slip per probe.
+  // Columns of coupler_surface.csv: <name>.x, .y, .nx, .ny, .tau, .slip, .p per probe.
   std::vector<std::string> columns() const;
 
-  // Merge the faces of every probe's stencils in `state` into the sorted face lists u_faces and
-  // v_faces (kept sorted and unique; idempotent).
+  // Merge the faces and cells of every probe's stencils in `state` into the sorted lists u_faces,
+  // v_faces and p_cells (kept sorted and unique; idempotent).
   void add_requests(const proto::SolidState& state, std::vector<std::int32_t>& u_faces,
-                    std::vector<std::int32_t>& v_faces);
+                    std::vector<std::int32_t>& v_faces, std::vector<std::int32_t>& p_cells);
 
-  // The row (columns() order) from the fluid's samples of u^(n+1) on the requested faces, with
-  // the surface in `state` (the configuration the fluid's forcing used). A stencil face missing
-  // from the samples is an error (the request was not sent).
+  // The row (columns() order) from the fluid's samples of u^(n+1) on the requested faces and of
+  // p^(n+1) in the requested cells, with the surface in `state` (the configuration the fluid's
+  // forcing used). A stencil face or cell missing from the samples is an error (the request was
+  // not sent).
   void evaluate(const proto::SolidState& state, const std::vector<std::int32_t>& u_faces,
                 const std::vector<double>& u, const std::vector<std::int32_t>& v_faces,
-                const std::vector<double>& v, std::vector<double>& row);
+                const std::vector<double>& v, const std::vector<std::int32_t>& p_cells,
+                const std::vector<double>& p, std::vector<double>& row);
+
+  // Values per probe in a row.
+  static constexpr int kColumns = 7;
 
   std::size_t size() const { return m_probes.size(); }
 
@@ -96,7 +106,7 @@ class SurfaceProbes {
   std::vector<Probe> m_probes;
   double m_mu;
   std::vector<double> m_xf, m_yf;
-  Family m_u, m_v;
+  Family m_u, m_v, m_p;
   std::vector<std::int32_t> m_scratch;
 };
 

@@ -27,12 +27,14 @@ void Coupler::setup_surface_probes() {
       fsi::output_csv(m_rt, m_rt.out_dir() / "coupler_surface.csv", m_surface->columns()));
 }
 
-// Before the fluid's step (iteration 0): the faces of the probes' stencils in the footprint's
+// Before the fluid's step (iteration 0): the faces and cells of the probes' stencils in the footprint's
 // configuration x^n join the step's sample request (the fibers' stencil, when there are fibers).
 void Coupler::request_surface_samples() {
   // Without fibers the request is the probes' alone (the last step's faces are not kept).
   if (!m_ib) m_fluid_in.sample_u.clear(), m_fluid_in.sample_v.clear();
-  m_surface->add_requests(footprint_state(), m_fluid_in.sample_u, m_fluid_in.sample_v);
+  m_fluid_in.sample_p.clear();
+  m_surface->add_requests(footprint_state(), m_fluid_in.sample_u, m_fluid_in.sample_v,
+                          m_fluid_in.sample_p);
 }
 
 // The accepted step n: tau and the slip at t^(n+1) from the fluid's u^(n+1), on the surface in
@@ -40,7 +42,8 @@ void Coupler::request_surface_samples() {
 void Coupler::write_surface_probes(long n) {
   if (!m_surface) return;
   m_surface->evaluate(footprint_state(), m_fluid_in.sample_u, m_fluid_out.u_sample,
-                      m_fluid_in.sample_v, m_fluid_out.v_sample, m_surface_row);
+                      m_fluid_in.sample_v, m_fluid_out.v_sample, m_fluid_in.sample_p,
+                      m_fluid_out.p_sample, m_surface_row);
   m_surface_csv->write(fsi::step_time(m_rt.settings(), n + 1), m_surface_row);
 }
 

@@ -42,6 +42,13 @@ void FiberSystem::save(fsi::H5File& h5) const {
     per.push_back(f.root_moment), per.push_back(f.tip_moment), per.push_back(f.tension_iterations);
   }
   h5.write("fiber/per_fiber", per);
+  std::vector<double> inertia;  // the root load's mass (xx, xy, yy) and acceleration
+  for (const Fiber& f : m_fibers) {
+    const auto& l = f.root_load;
+    inertia.insert(inertia.end(), {l.mass(0, 0), l.mass(0, 1), l.mass(1, 1)});
+    put(inertia, l.accel);
+  }
+  h5.write("fiber/root_inertia", inertia);
   std::vector<double> acc;
   for (const auto* loads : {&m_root_acc, &m_tip_acc})
     for (const EndLoad& l : *loads) put(acc, l.force), acc.push_back(l.moment);
@@ -66,6 +73,16 @@ void FiberSystem::load(const fsi::H5File& h5) {
     f.root_load.force = get(p), f.root_load.moment = *p++;
     f.tip_load.force = get(p), f.tip_load.moment = *p++;
     f.root_moment = *p++, f.tip_moment = *p++, f.tension_iterations = static_cast<int>(*p++);
+  }
+  const std::vector<double> inertia = h5.read_doubles("fiber/root_inertia");
+  if (inertia.size() != 5 * m_fibers.size())
+    fsi::fail("checkpoint {}: its root inertia is of other fibers", h5.path().string());
+  p = inertia.data();
+  for (Fiber& f : m_fibers) {
+    auto& l = f.root_load;
+    l.mass << p[0], p[1], p[1], p[2];
+    p += 3;
+    l.accel = get(p);
   }
   const std::vector<double> acc = h5.read_doubles("fiber/accumulated_loads");
   if (acc.size() != 3 * (m_root_acc.size() + m_tip_acc.size()))

@@ -119,6 +119,8 @@ void FiberProgram::state(fsi::proto::FiberState& s) const {
   s.x.resize(sys.fiber_count());
   s.x_old.resize(sys.fiber_count());
   s.root_load.resize(3 * sys.fiber_count());
+  s.root_mass.resize(3 * sys.fiber_count());
+  s.root_accel.resize(2 * sys.fiber_count());
   for (int k = 0; k < sys.fiber_count(); ++k) {
     const auto x = sys.positions(k), xo = sys.previous_positions(k);
     s.x[k].assign(x.begin(), x.end());
@@ -127,6 +129,11 @@ void FiberProgram::state(fsi::proto::FiberState& s) const {
     s.root_load[3 * k] = l.force.x();
     s.root_load[3 * k + 1] = l.force.y();
     s.root_load[3 * k + 2] = l.moment;
+    s.root_mass[3 * k] = l.mass(0, 0);
+    s.root_mass[3 * k + 1] = l.mass(0, 1);
+    s.root_mass[3 * k + 2] = l.mass(1, 1);
+    s.root_accel[2 * k] = l.accel.x();
+    s.root_accel[2 * k + 1] = l.accel.y();
   }
 }
 

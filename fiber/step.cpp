@@ -59,7 +59,8 @@ void FiberSystem::advance(double dt, std::span<const double> external_force,
 
   for (int k = 0; k < fiber_count(); ++k) {
     Fiber& s = m_fibers[k];
-    s.root_load = {m_root_acc[k].force / m, m_root_acc[k].moment / m};
+    s.root_load = {m_root_acc[k].force / m, m_root_acc[k].moment / m, m_root_acc[k].mass / m,
+                   m_root_acc[k].accel / m};
     s.tip_load = {m_tip_acc[k].force / m, m_tip_acc[k].moment / m};
     s.root_pose_old = s.root_pose_new;
   }
@@ -257,11 +258,38 @@ void FiberSystem::end_loads(int k, double h) {
   if (s.is_root_fixed) {
     m_root_acc[k].force += load_at(s.offset, s.seg_offset, 1.0);
     m_root_acc[k].moment += s.root_moment;
+    m_root_acc[k].mass += root_mass(k, h);
+    m_root_acc[k].accel += (at(m_x_new, s.offset) - 2 * at(m_x, s.offset) + at(m_x_old, s.offset)) * inv_h2;
   }
   if (s.is_tip_fixed) {
     m_tip_acc[k].force += load_at(s.offset + n, s.seg_offset + n - 1, -1.0);
     m_tip_acc[k].moment += s.tip_moment;
   }
+}
+
+// The root load's response to the root's acceleration, -d(load)/d(a_0), with the tension solved
+// again. Moving the root marker's X^(n+1)_0 by delta (a_0 by delta / h^2) changes only the
+// constraint of segment 0, dg_0 = -2 d_0.delta (d_j = X^(n+1)_{j+1} - X^(n+1)_j), so the tensions
+// change by dT = J^-1 e_0 (2 d_0.delta) (J the tension equation's tridiagonal Jacobian at the
+// solution, which solve_tension leaves in m_lo, m_di, m_up), and the load -R_0 = f_0 + T_0 r_0 / ds
+// - m_0 a_0 by (2 z / ds) r_0 d_0^T delta - m_0 delta / h^2, z = (J^-1)_00. Hence
+//   mass = m_0 I - (2 h^2 z / ds) r_0 d_0^T,
+// symmetrised (r_0 = d_0 up to the step's rotation of the first segment). z is the inverse of
+// the first pivot of J eliminated from the last row upwards (its Schur complement). The bending
+// forces' dependence on the root (a stiffness, O(h^2) against the inertia) is left out. For a
+// straight fiber, J^-1 makes the whole chain follow the root along its axis: mass ~ the fiber's
+// mass along it, m_0 across.
+Eigen::Matrix2d FiberSystem::root_mass(int k, double h) const {
+  const Fiber& s = m_fibers[k];
+  const int n = s.segments;
+  const std::size_t o = s.seg_offset;
+  double pivot = m_di[o + n - 1];
+  for (int j = n - 2; j >= 0; --j) pivot = m_di[o + j] - m_up[o + j] * m_lo[o + j + 1] / pivot;
+  const Vec2 r0 = at(m_ref, o);
+  const Vec2 d0 = at(m_x_new, s.offset + 1) - at(m_x_new, s.offset);
+  const Eigen::Matrix2d m = m_mass[s.offset] * Eigen::Matrix2d::Identity() -
+                            (2 * h * h / (pivot * s.ds)) * (r0 * d0.transpose());
+  return 0.5 * (m + m.transpose());
 }
 
 // Load on the driver of a prescribed fiber: sum_i (f_i - m_i a_i) with f_i = m_i g +

@@ -22,10 +22,16 @@ struct EndPose {
 };
 
 // Load a fiber exerts ON ITS SUPPORT at one end: force and moment (counter-clockwise positive)
-// about the end marker. Zero at a free end.
+// about the end marker. Zero at a free end. At a supported root also the force's linear response
+// to the root's acceleration a, force ~ force_0 - mass a (the fiber's inertia that the support
+// carries: about the whole fiber's mass along a straight fiber, the end marker's across it),
+// and the acceleration a this force was taken at; a support that moves by its own equations can
+// take the inertia implicitly (common/PROTOCOL.md, "Fiber roots").
 struct EndLoad {
   Vec2 force = Vec2::Zero();
   double moment = 0;
+  Eigen::Matrix2d mass = Eigen::Matrix2d::Zero();
+  Vec2 accel = Vec2::Zero();
 };
 
 // Wall time spent in each phase of a step, accumulated since construction [s].
@@ -134,6 +140,7 @@ class FiberSystem {
                std::span<const double> external_force);
   void solve_tension(int k);
   void end_loads(int k, double h);
+  Eigen::Matrix2d root_mass(int k, double h) const;
   void prescribed_load(int k, double h, std::span<const double> external_force);
   void prescribe(int k, double t, std::span<double> x) const;
   EndPose end_pose(int k, bool is_root, double t, double pose_weight) const;

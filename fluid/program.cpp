@@ -95,6 +95,7 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
   c.fiber_v_force = in.force_v.force;
   c.sample_u_index = in.sample_u;
   c.sample_v_index = in.sample_v;
+  c.sample_p_index = in.sample_p;
   if (s.iteration == 0) {
     m_solver->set_keep_for_redo(s.may_repeat != 0);
     begin(s);
@@ -106,6 +107,7 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
   out.fs_v = m_out.solid_v_force;
   out.u_sample = m_out.sample_u;
   out.v_sample = m_out.sample_v;
+  out.p_sample = m_out.sample_p;
   check_health(s.step + 1, s.time + s.dt, s.dt);
   out.cfl = m_cfl;
   out.max_div = m_div;

@@ -266,8 +266,14 @@ void Solver::correct(double dt, const CouplingIn& in, CouplingOut& out) {
   ++m_step;
 }
 
-// u^(n+1) on the faces the coupler asked for (the fibers' stencil), in its order.
+// u^(n+1) on the faces the coupler asked for (the fibers' and surface probes' stencils) and
+// p^(n+1) in its cells, in its order.
 void Solver::sample(const CouplingIn& in, CouplingOut& out) const {
+  out.sample_p.resize(in.sample_p_index.size());
+  for (std::size_t q = 0; q < in.sample_p_index.size(); ++q) {
+    const std::int32_t c = in.sample_p_index[q];
+    out.sample_p[q] = m_p(c % m_grid.nx(), c / m_grid.nx());
+  }
   out.sample_u.resize(in.sample_u_index.size());
   out.sample_v.resize(in.sample_v_index.size());
   for (std::size_t q = 0; q < in.sample_u_index.size(); ++q) {

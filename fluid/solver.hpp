@@ -40,14 +40,16 @@ struct CouplingIn {
   std::span<const std::int32_t> fiber_u_index, fiber_v_index;
   std::span<const double> fiber_u_force, fiber_v_force;
   std::span<const std::int32_t> sample_u_index, sample_v_index;
+  std::span<const std::int32_t> sample_p_index;  // cells i + nx j
 };
 // Output of one step:
 //   solid_*_force: f_s = rho_f alpha (u_s - u~) / dt on the solid's faces, in the input order,
 //                  force per unit volume ON THE FLUID (the solid receives its reaction).
-//   sample_*:      u^(n+1) on the requested faces, in the input order.
+//   sample_*:      u^(n+1) on the requested faces, p^(n+1) in the requested cells, in the
+//                  input order.
 struct CouplingOut {
   std::vector<double> solid_u_force, solid_v_force;
-  std::vector<double> sample_u, sample_v;
+  std::vector<double> sample_u, sample_v, sample_p;
 };
 
 // Seconds spent per phase, accumulated over steps.

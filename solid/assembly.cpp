@@ -185,6 +185,7 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
           if (map[k] >= 0) values[map[k]] += ke[k];
       }
     }
+    if (dynamic) add_root_mass(B, dt, with_matrix, r, absm);
     for (std::size_t d = 0; d < r.size(); ++d) {
       r[d] -= B.q[d];
       if (B.eq[d] >= 0) {
@@ -201,6 +202,50 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
   m_force_scale = std::sqrt(scale2);
   m_roundoff_scale = std::sqrt(floor2);
   return inverted;
+}
+
+// The fibers' root inertia (the coupler's root_mass: a 2 x 2 block m per node of the edges that
+// hold roots): the root loads in the coupling force come without it, and the node carries
+// -m a^(n+1), with a^(n+1) = (v^(n+1) - v^n) / dt the node's acceleration over the step, as an
+// impulse like the coupling force (weight s_d, 2 on dofs with mass). With
+// v_c^(n+1) = s_c (x_c^(n+1) - x_c^n) / dt - [mass] v_c^n,
+//   r_d -= s_d / dt sum_c m_dc (v_c^(n+1) - v_c^n),   K_dc += s_d s_c / dt^2 m_dc
+// (c over the node's two dofs): on a dof with mass exactly the Newmark inertia of a point mass m.
+void Solver::add_root_mass(Body& B, double dt, bool with_matrix, std::vector<double>& r,
+                           std::vector<double>& absm) {
+  if (!m_root_mass || static_cast<int>(m_root_mass->size()) <= B.index) return;
+  const auto& m = (*m_root_mass)[B.index];
+  if (m.empty()) return;
+  if (m.size() != 3 * (B.u.size() / 2))
+    fsi::fail("root masses for body '{}' have {} values, expected 3 per node = {}", B.spec.name,
+              m.size(), 3 * (B.u.size() / 2));
+  double* values = m_matrix.valuePtr();
+  for (std::size_t a = 0; a < m.size() / 3; ++a) {
+    if (m[3 * a] == 0 && m[3 * a + 1] == 0 && m[3 * a + 2] == 0) continue;
+    const double block[2][2] = {{m[3 * a], m[3 * a + 1]}, {m[3 * a + 1], m[3 * a + 2]}};
+    double sw[2], dv[2], vabs[2];
+    for (int i = 0; i < 2; ++i) {
+      const std::size_t d = 2 * a + i;
+      const bool mass = B.mass_row[d] > 0;
+      sw[i] = mass ? 2.0 : 1.0;
+      const double v = sw[i] * (B.u[d] - B.u_old[d]) / dt - (mass ? B.v_old[d] : 0.0);
+      dv[i] = v - B.v_old[d];
+      vabs[i] = std::abs(v) + std::abs(B.v_old[d]);
+    }
+    for (int i = 0; i < 2; ++i) {
+      const std::size_t d = 2 * a + i;
+      for (int j = 0; j < 2; ++j) {
+        r[d] -= sw[i] / dt * block[i][j] * dv[j];
+        absm[d] += sw[i] / dt * std::abs(block[i][j]) * vabs[j];
+        if (!with_matrix) continue;
+        const int er = B.eq[d], ec = B.eq[2 * a + j];
+        if (er < 0 || ec < 0 || er < ec) continue;
+        const int k = matrix_index(er, ec);
+        FSI_ASSERT(k >= 0);
+        values[k] += sw[i] * sw[j] / (dt * dt) * block[i][j];
+      }
+    }
+  }
 }
 
 }  // namespace solid

@@ -36,7 +36,8 @@ void Solver::factorize_ahead(double dt) {
 //   R(x) = F(t^(n+1)) - Q(x) - (4/dt^2) M (x - x^n - dt v^n) + (M a)^n + 2 F_c,
 // R(x^(n+1)) + B^T lambda = 0 with the contact conditions, then the trapezoidal update.
 StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* external,
-                           const std::vector<std::vector<double>>* iteration_velocity) {
+                           const std::vector<std::vector<double>>* iteration_velocity,
+                           const std::vector<std::vector<double>>* root_mass) {
   if (!(dt > 0)) fsi::fail("time step must be > 0, got {}", dt);
   if (m_bodies.empty()) {  // a scene without bodies: only the clock moves
     m_time += dt;
@@ -55,14 +56,17 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
   // Coupled iterations: the fluid's reaction is linearised about the coupler's velocity
   // (assembly.cpp); without a fluid there is no reaction to linearise.
   m_iteration_velocity = m_model.settings.fluid_density > 0 ? iteration_velocity : nullptr;
+  m_root_mass = root_mass;
   StepReport rep;
   try {
     rep = newton(newmark_c0(dt), dt, t1, external, when);
   } catch (...) {
     m_iteration_velocity = nullptr;
+    m_root_mass = nullptr;
     throw;
   }
   m_iteration_velocity = nullptr;
+  m_root_mass = nullptr;
   update_velocity(dt);
   m_time = t1;
   m_step++;

@@ -75,8 +75,13 @@ class Solver {
   // w at t + dt whose footprint the fluid's forcing used for `external`. When the scene has a
   // fluid (settings.fluid_density > 0) the step linearises the reaction about it (assembly.cpp):
   // a term that vanishes when the step returns v^(n+1) = w.
+  //
+  // Fiber roots: root_mass[b] (may be null or empty per body) holds the fibers' root inertia,
+  // a 2 x 2 block (m_xx, m_xy, m_yy) per node; the node then carries -m a^(n+1) with its own
+  // acceleration over the step (assembly.cpp, add_root_mass).
   StepReport advance(double dt, const std::vector<std::vector<double>>* external = nullptr,
-                     const std::vector<std::vector<double>>* iteration_velocity = nullptr);
+                     const std::vector<std::vector<double>>* iteration_velocity = nullptr,
+                     const std::vector<std::vector<double>>* root_mass = nullptr);
   // Look-ahead: the first Newton matrix of the next dynamic step of size dt (at the current
   // state; forces enter only the residual), factorised now, while a coupled solid waits for its
   // forces. The step finds the factor done: a factorisation is skipped when the matrix equals
@@ -154,6 +159,8 @@ class Solver {
   // Returns the first inverted element as (body, element) or (-1, -1).
   std::pair<int, int> assemble(double c0, double dt, bool with_matrix, double load_factor,
                                const std::vector<std::vector<double>>* external);
+  void add_root_mass(Body& B, double dt, bool with_matrix, std::vector<double>& r,
+                     std::vector<double>& absm);
   // Newton on the step's residual with contact (newton.cpp) and its parts.
   StepReport newton(double c0, double dt, double load_factor,
                     const std::vector<std::vector<double>>* external, const std::string& when);
@@ -211,6 +218,7 @@ class Solver {
   double m_contact_force_factor = 1;  // physical contact force / multiplier (1/2 in Newmark)
   bool m_dirichlet_pending = false;   // a prescribed increment awaits the first Newton solve
   const std::vector<std::vector<double>>* m_iteration_velocity = nullptr;  // during advance()
+  const std::vector<std::vector<double>>* m_root_mass = nullptr;            // during advance()
 };
 
 }  // namespace solid

@@ -17,7 +17,13 @@ With coupled iterations the coupler also sends the nodal velocities w the fluid'
 about them the reaction is F_c(v) ~ F_c - M_f (v - w)/dt (M_f the fluid's mass matrix in the
 body). For a rigid v this is F - m_f (V - V_w)/dt and T - J_f (W - W_w)/dt, with m_f = rho_f A,
 J_f = rho_f I_c and (V_w, W_w) the rigid motion of the same momentum as w: the step solves with
-the whole mass rho_s A (the term vanishes at convergence, v = w)."""
+the whole mass rho_s A (the term vanishes at convergence, v = w).
+
+Fibers rooted on the body (protocol version 7): the coupler's root_mass gives a 2 x 2 block m_a
+at some nodes, which carry -m_a (v_a^(n+1) - v_a^n)/dt besides the forces (the fibers' inertia,
+taken implicitly). With v_a = G_a (V, W), G_a = [[1, 0, -r_y], [0, 1, r_x]], the step solves the
+3 x 3 system (diag(m, m, J) + sum_a G_a^T m_a G_a) (V, W)^(n+1) = (momenta above)
++ sum_a G_a^T m_a G_a (V, W)^n."""
 import math
 
 import numpy as np
@@ -91,7 +97,7 @@ class RigidBody:
         lumped = (self.w * (r * r).sum(axis=1)).sum()
         return Vw, Lw / lumped
 
-    def advance(self, dt, force, velocity):
+    def advance(self, dt, force, velocity, root_mass=None):
         """One step from the current state (t^n) with the nodal forces (on the solid) at x^n."""
         if self.fixed:
             self.F, self.T = self.resultant(force)
@@ -110,7 +116,21 @@ class RigidBody:
                           f"<= rho_f: excess mass {self.m:g}); turn on coupled iterations "
                           "([coupler.iterations] max > 1), in which the fluid's reaction is "
                           "linearised and the body carries its whole mass rho_s A")
-        V1, W1 = p / m, L / J
+        if root_mass is not None and root_mass.size:
+            A = np.diag([m, m, J])
+            b = np.array([p[0], p[1], L])
+            r = self.offsets()
+            blocks = root_mass.reshape(-1, 3)
+            for a in np.nonzero(np.abs(blocks).sum(axis=1))[0]:
+                mxx, mxy, myy = blocks[a]
+                G = np.array([[1.0, 0.0, -r[a, 1]], [0.0, 1.0, r[a, 0]]])
+                GmG = G.T @ np.array([[mxx, mxy], [mxy, myy]]) @ G
+                A += GmG
+                b += GmG @ np.array([self.V[0], self.V[1], self.W])
+            sol = np.linalg.solve(A, b)
+            V1, W1 = sol[:2], float(sol[2])
+        else:
+            V1, W1 = p / m, L / J
         self.C = self.C + 0.5 * dt * (self.V + V1)
         self.th += 0.5 * dt * (self.W + W1)
         self.V, self.W = V1, W1

@@ -127,6 +127,7 @@ class Program:
                                  f"state after step {n} is not saved\n")
             r = c.recv("solid_input")
             force, velocity = r.vec_list(np.float64), r.vec_list(np.float64)
+            root_mass = r.vec_list(np.float64)
             r.done()
             t0 = wire.now()
             if len(force) != len(self.bodies) or (velocity and len(velocity) != len(self.bodies)):
@@ -143,7 +144,11 @@ class Program:
                 if f.size and f.size != b.x_ref.size:
                     raise wire.Failure(f"protocol error: {f.size} force values for body "
                                        f"'{b.name}' of {b.x_ref.size // 2} nodes")
-                b.advance(dt, f, velocity[k] if velocity else None)
+                m = root_mass[k] if k < len(root_mass) else None
+                if m is not None and m.size and m.size != 3 * (b.x_ref.size // 2):
+                    raise wire.Failure(f"protocol error: {m.size} root mass values for body "
+                                       f"'{b.name}' of {b.x_ref.size // 2} nodes")
+                b.advance(dt, f, velocity[k] if velocity else None, m)
             out = self.state(t + dt, n)
             self.port_seconds += wire.now() - t0
             c.send(out)

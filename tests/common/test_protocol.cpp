@@ -58,32 +58,38 @@ TEST_CASE("every message survives a round trip") {
   fi.solid_u = {{1, 5, 9}, {0.5, 1.0, 0.25}, {0.1, 0.2, 0.3}};
   fi.force_v = {{4}, {-2.5}};
   fi.sample_u = {3, 4};
+  fi.sample_p = {7};
   const auto fi2 = round_trip(fi);
   CHECK(fi2.solid_u.index == fi.solid_u.index);
   CHECK(fi2.solid_u.velocity == fi.solid_u.velocity);
   CHECK(fi2.solid_v.index.empty());
   CHECK(fi2.force_v.force == fi.force_v.force);
   CHECK(fi2.sample_u == fi.sample_u);
+  CHECK(fi2.sample_p == fi.sample_p);
 
-  FluidOutput fo{{1.5, -2}, {}, {0.25}, {}, 0.3, 1e-15, 2.5};
+  FluidOutput fo{{1.5, -2}, {}, {0.25}, {}, {4.5}, 0.3, 1e-15, 2.5};
   const auto fo2 = round_trip(fo);
   CHECK(fo2.fs_u == fo.fs_u);
   CHECK(fo2.cfl == 0.3);
+  CHECK(fo2.p_sample == fo.p_sample);
 
-  SolidInput si{{{1, 2, 3, 4}, {}}, {{0.5, -0.5, 0, 1}, {}}};
+  SolidInput si{{{1, 2, 3, 4}, {}}, {{0.5, -0.5, 0, 1}, {}}, {{}, {0.1, 0, 0.2, 0, 0, 0}}};
   const auto si2 = round_trip(si);
   CHECK(si2.force == si.force);
   CHECK(si2.velocity == si.velocity);
+  CHECK(si2.root_mass == si.root_mass);
   SolidState ss{0.5, {{0, 0, 1, 0}}, {{0, 1, 0, 1}}};
   const auto ss2 = round_trip(ss);
   CHECK(ss2.x == ss.x);
   CHECK(ss2.v == ss.v);
   FiberInput fin{{{0.1, 0.2}}, {{0, 0, 0, 1}}};
   CHECK(round_trip(fin).root_pose == fin.root_pose);
-  FiberState fs{1.0, {{0, 0, 0, 1}}, {{0, 0, 0, 0.9}}, {1, 2, 3}};
+  FiberState fs{1.0, {{0, 0, 0, 1}}, {{0, 0, 0, 0.9}}, {1, 2, 3}, {0.5, 0, 0.01}, {-1, 2}};
   const auto fs2 = round_trip(fs);
   CHECK(fs2.x_old == fs.x_old);
   CHECK(fs2.root_load == fs.root_load);
+  CHECK(fs2.root_mass == fs.root_mass);
+  CHECK(fs2.root_accel == fs.root_accel);
 }
 
 TEST_CASE("damaged or mismatched messages are refused") {
@@ -116,9 +122,9 @@ TEST_CASE("damaged or mismatched messages are refused") {
     FluidInput fi;
     fi.sample_u = {1, 2, 3};
     auto b = pack_message(fi, 0);
-    // sample_u's length sits before its 3 ints and sample_v's (empty) length.
+    // sample_u's length sits before its 3 ints and sample_v's and sample_p's (empty) lengths.
     const std::int64_t huge = 1000;
-    std::memcpy(b.data() + b.size() - 8 - 12 - 8, &huge, sizeof huge);
+    std::memcpy(b.data() + b.size() - 8 - 8 - 12 - 8, &huge, sizeof huge);
     FluidInput back;
     CHECK_THROWS_WITH(unpack_message(b, back), Catch::Contains("does not fit"));
   }

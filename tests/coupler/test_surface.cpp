@@ -51,18 +51,22 @@ proto::SolidState state_of(const proto::BodyMeshes& m, const Field& body_velocit
   return s;
 }
 
-// The probe's row with the requested faces sampled from `field` (u at u-faces, v at v-faces).
+using Scalar = std::function<double(double, double)>;
+
+// The probe's row with the requested faces sampled from `field` (u at u-faces, v at v-faces)
+// and the requested cells from `pressure` (at the cell centres; zero when not given).
 std::vector<double> probe(const proto::GridInfo& g, const proto::BodyMeshes& m,
                           std::array<double, 2> point, double mu, const Field& field,
-                          const Field& body_velocity = nullptr) {
+                          const Field& body_velocity = nullptr, const Scalar& pressure = nullptr) {
   SurfaceProbes sp(g, m, {{"P", "wall", point}}, mu, "test.toml");
   const auto st = state_of(m, body_velocity);
-  std::vector<std::int32_t> uf, vf;
-  sp.add_requests(st, uf, vf);
-  std::vector<std::int32_t> uf2 = uf, vf2 = vf;
-  sp.add_requests(st, uf2, vf2);
+  std::vector<std::int32_t> uf, vf, pc;
+  sp.add_requests(st, uf, vf, pc);
+  std::vector<std::int32_t> uf2 = uf, vf2 = vf, pc2 = pc;
+  sp.add_requests(st, uf2, vf2, pc2);
   CHECK(uf2 == uf);  // idempotent
   CHECK(vf2 == vf);
+  CHECK(pc2 == pc);
   const int nu = g.periodic_x ? g.nx : g.nx + 1;
   std::vector<double> u, v;
   for (std::int32_t f : uf) {
@@ -73,9 +77,16 @@ std::vector<double> probe(const proto::GridInfo& g, const proto::BodyMeshes& m,
     const int i = f % g.nx, j = f / g.nx;
     v.push_back(field(0.5 * (g.x_face[i] + g.x_face[i + 1]), g.y_face[j])[1]);
   }
+  std::vector<double> p;
+  for (std::int32_t c : pc) {
+    const int i = c % g.nx, j = c / g.nx;
+    p.push_back(pressure ? pressure(0.5 * (g.x_face[i] + g.x_face[i + 1]),
+                                    0.5 * (g.y_face[j] + g.y_face[j + 1]))
+                         : 0.0);
+  }
   std::vector<double> row;
-  sp.evaluate(st, uf, u, vf, v, row);
-  REQUIRE(row.size() == 6);
+  sp.evaluate(st, uf, u, vf, v, pc, p, row);
+  REQUIRE(row.size() == SurfaceProbes::kColumns);
   return row;
 }
 
@@ -146,6 +157,44 @@ TEST_CASE("surface probe: a parabolic profile is exact on an aligned wall, first
     INFO("n = " << n << ": relative error " << e);
     CHECK(e <= 3.5 * (1.0 / n) / H);
     CHECK(e <= e20 * 20.0 / n);
+  }
+}
+
+TEST_CASE("surface probe: the pressure is exact for a linear field, second order for a smooth one",
+          "[coupler][surface]") {
+  // p = a + b.x: the line through the two nearest fluid points is the field, at any angle and
+  // across a periodic boundary. p = cos(k . x): the error of the bilinear interpolation and of
+  // the extrapolation, O(h^2).
+  const Field still = [](double, double) { return std::array<double, 2>{0.0, 0.0}; };
+  for (bool periodic : {false, true})
+    for (double deg : {0.0, 21.0, 90.0, 160.0}) {
+      const auto g = grid(40, 40, 1.0, 1.0, periodic, false);
+      const double th = deg * std::numbers::pi / 180;
+      const auto m = block(periodic ? 0.05 : 0.5, 0.4, 0.4, 0.2, th);
+      const double nx = -std::sin(th), ny = std::cos(th);
+      const double px = (periodic ? 0.05 : 0.5) + 0.1 * nx, py = 0.4 + 0.1 * ny;
+      const Scalar lin = [&](double x, double y) {
+        // periodic in x: no x-gradient (a periodic linear field would jump)
+        return 2.0 + (periodic ? 0.0 : -1.3 * x) + 0.7 * y;
+      };
+      const auto row = probe(g, m, {px, py}, 1.0, still, nullptr, lin);
+      INFO("wall at " << deg << " degrees, periodic " << periodic);
+      CHECK(row[6] == Approx(lin(px, py)).epsilon(1e-12));
+    }
+  // The bound: the line's extrapolation error |p_nn| d_0 d_1 / 2 = 4.375 h^2 |p_nn| plus the
+  // bilinear errors h^2 / 8 (|p_xx| + |p_yy|) at the two points, weighted 3.5 and 2.5: with
+  // |p''| <= 13 for this p, 66.6 h^2. The two parts change sign independently from grid to grid
+  // (the point's place in its cells), so the error is bounded, not monotone.
+  for (int n : {40, 80, 160, 320}) {
+    const auto g = grid(n, n, 1.0, 1.0, false, false);
+    const auto m = block(0.5, 0.3, 0.4, 0.2, 0.3);
+    const double nx = -std::sin(0.3), ny = std::cos(0.3);
+    const double px = 0.5 + 0.1 * nx, py = 0.3 + 0.1 * ny;
+    const Scalar wave = [](double x, double y) { return std::cos(3 * x + 2 * y); };
+    const double e = std::abs(probe(g, m, {px, py}, 1.0, still, nullptr, wave)[6] - wave(px, py));
+    const double h = 1.0 / n;
+    INFO("n = " << n << ": error " << e << ", bound " << 66.6 * h * h);
+    CHECK(e <= 66.6 * h * h);
   }
 }
 

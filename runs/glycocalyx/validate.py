@@ -1,0 +1,171 @@
+#!/usr/bin/python3
+"""The glycocalyx channel (paper Sec. 5.2, Table 4): a pulsatile flow over a wavy wall, rigid or
+elastic, with or without sixteen fibers clamped on it (make_scene.py writes the scenes;
+README.md states the set-up and what was chosen where the paper's text is silent).
+
+Four variants (rigid / elastic wall, without / with fibers), each for --periods periods of the
+driving (T = 1.2); statistics over the last --last periods:
+- at point C on the wall (the trough x = 1/2): the wall shear stress tau (paper Eq. 30; mean and
+  amplitude (max - min)/2) and the pressure's amplitude, from [[coupler.surface_probe]];
+- the flow rate through x = 1/2 (amplitude and mean);
+- the fluid velocity at D (centre line above C) and the wall's velocity at C: their amplitudes
+  and their phases at the driving frequency, against that of the flow rate;
+and the paper's findings as reported (not judged) yes/no: fibers lower the WSS at C, the elastic
+wall lowers it further, fibers raise the pressure fluctuation at C, fibers lower the flow-rate
+fluctuation, the wall moves in phase with the pulsation. --sweep adds the elastic wall with
+fibers at other Young's moduli (the flow-rate amplitude against E, the paper's Fig. 23).
+
+--short (./fsi test): the elastic wall with fibers for 400 steps; judged: the run holds (the
+fibers' root inertia on a wall whose nodes are 60 times lighter than a fiber: explicit, it
+diverges within 10 steps), and the wall at C moves slower than the fluid at D.
+Environment: FSI_BIN, FSI_OUT, FSI_ROOT; FSI_MPIRUN (default mpirun)."""
+import math
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "lib"))
+sys.path.insert(0, HERE)
+import cli  # noqa: E402
+import job  # noqa: E402
+import make_scene  # noqa: E402
+import numpy as np  # noqa: E402
+from metrics import at_most, finish, holds, reported  # noqa: E402
+from outputs import table  # noqa: E402
+
+P = cli.parser(__doc__)
+P.add_argument("--periods", type=cli.positive, default=10.0, help="periods per variant (10)")
+P.add_argument("--last", type=cli.positive, default=2.0,
+               help="periods at the end the statistics cover (2)")
+P.add_argument("--variants", default="rigid,rigid-fibers,elastic-fibers,elastic",
+               help="comma-separated, of rigid, rigid-fibers, elastic-fibers, elastic")
+P.add_argument("--sweep", type=lambda t: [float(v) for v in t.split(",")], default=None,
+               help="Young's moduli of the wall for the elastic wall with fibers, e.g. 3,30,100")
+P.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
+ARGS = P.parse_args()
+OUT = job.out_dir("glycocalyx")
+T = make_scene.PERIOD
+OMEGA = 2 * math.pi / T
+
+VARIANTS = {"rigid": (False, False), "rigid-fibers": (False, True),
+            "elastic-fibers": (True, True), "elastic": (True, False)}
+
+
+def run(name, elastic, fibers, periods, e_wall=make_scene.E_WALL, interval=0.1):
+    text = make_scene.scene(name, elastic=elastic, fibers=fibers, periods=periods, e_wall=e_wall,
+                            interval=interval)
+    return job.run(name, text, work=os.path.join(OUT, "runs"), reuse=ARGS.reuse)
+
+
+def window(t, t_end, last):
+    return t >= t_end - last * T - 1e-9
+
+
+def amplitude(y):
+    return 0.5 * (float(np.max(y)) - float(np.min(y)))
+
+
+def phase(t, y):
+    """The phase (radians) of y's component at the driving frequency over whole periods."""
+    c = np.trapz(y * np.exp(-1j * OMEGA * t), t)
+    return float(np.angle(c))
+
+
+def wrap(a):
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+def statistics(folder, elastic, t_end, last):
+    s = table(os.path.join(folder, "coupler_surface.csv"))
+    q = table(os.path.join(folder, "fluid_flow_rate.csv"))
+    d = table(os.path.join(folder, "fluid_probes.csv"))
+    ws, wq, wd = (window(x["time"], t_end, last) for x in (s, q, d))
+    out = {"tau_mean": float(np.mean(s["C.tau"][ws])), "tau_amplitude": amplitude(s["C.tau"][ws]),
+           "p_amplitude": amplitude(s["C.p"][ws]),
+           "flow_rate_mean": float(np.mean(q["Q0"][wq])), "flow_rate_amplitude": amplitude(q["Q0"][wq]),
+           "u_D_amplitude": amplitude(d["D.ux"][wd])}
+    phi_q = phase(q["time"][wq], q["Q0"][wq])
+    out["u_D_phase_deg"] = math.degrees(wrap(phase(d["time"][wd], d["D.ux"][wd]) - phi_q))
+    if elastic:
+        c = table(os.path.join(folder, "solid_probes.csv"))
+        wc = window(c["time"], t_end, last)
+        out["wall_v_C_amplitude"] = amplitude(c["C.vx"][wc])
+        out["wall_v_C_phase_deg"] = math.degrees(wrap(phase(c["time"][wc], c["C.vx"][wc]) - phi_q))
+    return out
+
+
+def short():
+    steps = 400
+    r = job.run("short", make_scene.scene("glycocalyx-short", periods=steps * make_scene.DT / T,
+                                          interval=0.01),
+                work=os.path.join(OUT, "runs"), check=False)
+    metrics = {"run_holds": holds(r.returncode == 0)}
+    if r.returncode != 0:
+        print(job.first_error(r.log))
+    else:
+        c = table(os.path.join(r.folder, "solid_probes.csv"))
+        d = table(os.path.join(r.folder, "fluid_probes.csv"))
+        wall = float(np.max(np.hypot(c["C.vx"], c["C.vy"])))
+        fluid = float(np.max(np.abs(d["D.ux"])))
+        print(f"glycocalyx --short: {steps} steps in {r.wall:.1f} s; wall speed at C up to "
+              f"{wall:.3e}, fluid speed at D up to {fluid:.3e}")
+        metrics["wall_speed_C_over_fluid_speed_D"] = at_most(wall / fluid, 1.0)
+    finish("glycocalyx", metrics, short=True)
+
+
+def main():
+    if ARGS.short:
+        return short()
+    periods, last = ARGS.periods, min(ARGS.last, ARGS.periods)
+    t_end = periods * T
+    results, metrics = {}, {}
+    for v in ARGS.variants.split(","):
+        if v not in VARIANTS:
+            raise SystemExit(f"--variants: unknown variant '{v}' (of {', '.join(VARIANTS)})")
+        elastic, fibers = VARIANTS[v]
+        r = run(f"{v}", elastic, fibers, periods)
+        results[v] = statistics(r.folder, elastic, t_end, last)
+        results[v]["wall_s"] = r.wall
+        print(f"{v}: " + ", ".join(f"{k} {x:.4g}" for k, x in results[v].items()), flush=True)
+        for k, x in results[v].items():
+            metrics[f"{v}.{k}"] = reported(x)
+    r = results
+    findings = []
+    if "rigid" in r and "rigid-fibers" in r:
+        findings += [("fibers_lower_wss_amplitude_at_C",
+                      r["rigid-fibers"]["tau_amplitude"] < r["rigid"]["tau_amplitude"]),
+                     ("fibers_raise_pressure_fluctuation_at_C",
+                      r["rigid-fibers"]["p_amplitude"] > r["rigid"]["p_amplitude"]),
+                     ("fibers_lower_flow_rate_fluctuation",
+                      r["rigid-fibers"]["flow_rate_amplitude"] < r["rigid"]["flow_rate_amplitude"])]
+    if "rigid-fibers" in r and "elastic-fibers" in r:
+        findings.append(("elastic_wall_lowers_wss_amplitude_further",
+                         r["elastic-fibers"]["tau_amplitude"] < r["rigid-fibers"]["tau_amplitude"]))
+    if "elastic-fibers" in r:
+        findings.append(("wall_moves_in_phase_with_flow",
+                         abs(r["elastic-fibers"]["wall_v_C_phase_deg"]) < 30.0))
+    for k, ok in findings:
+        metrics[k] = reported(float(ok))
+        print(f"  {k}: {'yes' if ok else 'no'}")
+    sweep = {}
+    for e in ARGS.sweep or []:
+        name = f"elastic-fibers-E{e:g}"
+        rr = run(name, True, True, periods, e_wall=e)
+        sweep[e] = statistics(rr.folder, True, t_end, last)
+        sweep[e]["wall_s"] = rr.wall
+        metrics[f"sweep_E{e:g}.flow_rate_amplitude"] = reported(sweep[e]["flow_rate_amplitude"])
+        print(f"E = {e:g}: flow-rate amplitude {sweep[e]['flow_rate_amplitude']:.5g}", flush=True)
+    print("\n| variant | tau mean at C | tau amplitude | p amplitude at C | flow-rate amplitude | "
+          "wall v at C, phase | wall s |")
+    print("|---|---|---|---|---|---|---|")
+    for v, x in r.items():
+        wall = (f"{x['wall_v_C_amplitude']:.3g}, {x['wall_v_C_phase_deg']:.0f}°"
+                if "wall_v_C_amplitude" in x else "-")
+        print(f"| {v} | {x['tau_mean']:.4g} | {x['tau_amplitude']:.4g} | {x['p_amplitude']:.4g} | "
+              f"{x['flow_rate_amplitude']:.4g} | {wall} | {x['wall_s']:.0f} |")
+    finish("glycocalyx", metrics, {"variants": r, "sweep": {str(k): v for k, v in sweep.items()},
+                                   "periods": periods, "last": last})
+
+
+if __name__ == "__main__":
+    main()
