@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "error.hpp"
 
@@ -13,6 +14,14 @@ double peskin4(double r) {
   if (a <= 1) return (3 - 2 * a + std::sqrt(1 + 4 * a - 4 * a * a)) / 8;
   if (a <= 2) return (5 - 2 * a - std::sqrt(std::max(0.0, -7 + 12 * a - 4 * a * a))) / 8;
   return 0;
+}
+
+void peskin4_weights(double r, double w[4]) {
+  const double q = std::sqrt(std::max(0.0, 1 + 4 * r - 4 * r * r));
+  w[0] = (3 - 2 * r - q) / 8;
+  w[1] = (3 - 2 * r + q) / 8;
+  w[2] = (1 + 2 * r + q) / 8;
+  w[3] = (1 + 2 * r - q) / 8;
 }
 
 namespace {
@@ -52,9 +61,9 @@ void FeedbackIB::kernel(const Family& f, double X, double Y, std::int32_t idx[16
   const int i0 = static_cast<int>(std::floor(sx)) - 1, j0 = static_cast<int>(std::floor(sy)) - 1;
   double wx[4], wy[4];
   int ii[4], jj[4];
+  peskin4_weights(sx - (i0 + 1), wx);
+  peskin4_weights(sy - (j0 + 1), wy);
   for (int k = 0; k < 4; ++k) {
-    wx[k] = peskin4(sx - (i0 + k));
-    wy[k] = peskin4(sy - (j0 + k));
     int i = i0 + k, j = j0 + k;
     if (f.px) i = ((i % f.ni) + f.ni) % f.ni;
     else if (i < 0 || i >= f.ni) i = -1;
@@ -69,12 +78,14 @@ void FeedbackIB::kernel(const Family& f, double X, double Y, std::int32_t idx[16
     }
 }
 
+// Each face is marked once; the list is read off the marks between the smallest and the largest
+// marked index, which gives it sorted without a sort (the faces of a fiber layer lie in a band of
+// rows: a few times the listed faces to scan).
 void FeedbackIB::stencil(const std::vector<std::vector<double>>& markers, int margin,
                          std::vector<std::int32_t>& u_faces, std::vector<std::int32_t>& v_faces) {
-  // Neighbouring markers share most of their windows: each face is listed once through a mark
-  // per face (cleared again from the list), so only the distinct faces are sorted.
   for (auto [f, out] : {std::pair{&m_u, &u_faces}, std::pair{&m_v, &v_faces}}) {
     out->clear();
+    std::int32_t lo = std::numeric_limits<std::int32_t>::max(), hi = -1;
     for (const auto& x : markers) {
       int ic_prev = 0, jc_prev = 0;
       for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
@@ -92,15 +103,14 @@ void FeedbackIB::stencil(const std::vector<std::vector<double>>& markers, int ma
             if (f->px) a = ((a % f->ni) + f->ni) % f->ni;
             else if (a < 0 || a >= f->ni) continue;
             const std::int32_t k = a + f->ni * b;
-            if (f->mark[k]) continue;
             f->mark[k] = 1;
-            out->push_back(k);
+            lo = std::min(lo, k), hi = std::max(hi, k);
           }
         }
       }
     }
-    for (const std::int32_t k : *out) f->mark[k] = 0;
-    std::sort(out->begin(), out->end());
+    for (std::int32_t k = lo; k <= hi; ++k)
+      if (f->mark[k]) out->push_back(k), f->mark[k] = 0;
   }
 }
 
@@ -117,14 +127,25 @@ void FeedbackIB::store_samples(const std::vector<std::int32_t>& u_faces, const s
   }
 }
 
+void FeedbackIB::kernels(const std::vector<double>& x) const {
+  if (x == m_kernel_x) return;
+  const std::size_t markers = x.size() / 2;
+  m_idx.resize(32 * markers), m_w.resize(32 * markers);
+  for (std::size_t m = 0; m < markers; ++m)
+    for (int c = 0; c < 2; ++c)
+      kernel(c == 0 ? m_u : m_v, x[2 * m], x[2 * m + 1], &m_idx[32 * m + 16 * c],
+             &m_w[32 * m + 16 * c]);
+  m_kernel_x = x;
+}
+
 void FeedbackIB::interpolate(const std::vector<double>& x, std::vector<double>& u) const {
+  kernels(x);
   u.assign(x.size(), 0.0);
-  std::int32_t idx[16];
-  double w[16];
   for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
     for (int c = 0; c < 2; ++c) {
       const Family& f = c == 0 ? m_u : m_v;
-      kernel(f, x[m], x[m + 1], idx, w);
+      const std::int32_t* idx = &m_idx[16 * m + 16 * c];
+      const double* w = &m_w[16 * m + 16 * c];
       double s = 0;
       for (int k = 0; k < 16; ++k) {
         if (idx[k] < 0 || w[k] == 0) continue;
@@ -140,34 +161,34 @@ void FeedbackIB::interpolate(const std::vector<double>& x, std::vector<double>& 
 }
 
 void FeedbackIB::spread(const std::vector<double>& x, const std::vector<double>& F, double ds) {
-  std::int32_t idx[16];
-  double w[16];
+  kernels(x);
   const std::size_t last = x.size() - 2;
   for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
     const double scale = -(m == 0 || m == last ? 0.5 * ds : ds) / (m_hx * m_hy);
     for (int c = 0; c < 2; ++c) {
       Family& f = c == 0 ? m_u : m_v;
-      kernel(f, x[m], x[m + 1], idx, w);
+      const std::int32_t* idx = &m_idx[16 * m + 16 * c];
+      const double* w = &m_w[16 * m + 16 * c];
       for (int k = 0; k < 16; ++k) {
         if (idx[k] < 0 || w[k] == 0) continue;
-        if (f.force[idx[k]] == 0) f.touched.push_back(idx[k]);
+        f.mark[idx[k]] = 1;
+        f.lo = std::min(f.lo, idx[k]), f.hi = std::max(f.hi, idx[k]);
         f.force[idx[k]] += scale * F[m + c] * w[k];
       }
     }
   }
 }
 
+// The touched faces read off their marks in index order (sorted, as stencil()).
 void FeedbackIB::take_spread(proto::FaceForce& u, proto::FaceForce& v) {
   for (auto [f, out] : {std::pair{&m_u, &u}, std::pair{&m_v, &v}}) {
-    std::sort(f->touched.begin(), f->touched.end());
-    f->touched.erase(std::unique(f->touched.begin(), f->touched.end()), f->touched.end());
-    out->index = f->touched;
-    out->force.resize(f->touched.size());
-    for (std::size_t k = 0; k < f->touched.size(); ++k) {
-      out->force[k] = f->force[f->touched[k]];
-      f->force[f->touched[k]] = 0;
+    out->index.clear(), out->force.clear();
+    for (std::int32_t k = f->lo; k <= f->hi; ++k) {
+      if (!f->mark[k]) continue;
+      out->index.push_back(k), out->force.push_back(f->force[k]);
+      f->force[k] = 0, f->mark[k] = 0;
     }
-    f->touched.clear();
+    f->lo = std::numeric_limits<std::int32_t>::max(), f->hi = -1;
   }
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "protocol.hpp"
@@ -18,6 +19,12 @@ namespace proto = fsi::proto;
 // Σ_i φ(r − i) = 1 and Σ_i (r − i) φ(r − i) = 0 for every r, so constants and linear fields are
 // interpolated exactly and spreading conserves force.
 double peskin4(double r);
+
+// The four weights φ(r + 1), φ(r), φ(r − 1), φ(r − 2) of the points i0 .. i0 + 3 around a point
+// at i0 + 1 + r, r in [0, 1). With q = sqrt(1 + 4r − 4r²) they are (3 − 2r − q)/8,
+// (3 − 2r + q)/8, (1 + 2r + q)/8, (1 + 2r − q)/8 (the radicands of both branches of φ at these
+// four distances are the same): one square root for all four.
+void peskin4_weights(double r, double w[4]);
 
 class FeedbackIB {
  public:
@@ -37,6 +44,8 @@ class FeedbackIB {
 
   // U(X) = Σ_faces u_f φ((x_f − X)/h_x) φ((y_f − Y)/h_y) at each marker, from stored samples. A
   // face of the kernel that was not sampled is an error (a marker moved more than the margin).
+  // The kernels are kept for a spread() of the same markers that follows (the feedback force's
+  // interpolation and spreading use the same Xⁿ).
   void interpolate(const std::vector<double>& x, std::vector<double>& u) const;
 
   // The force per unit volume on the fluid from forces per unit length F on the markers of one
@@ -58,15 +67,22 @@ class FeedbackIB {
     std::vector<double> value;   // sampled velocity per face
     std::vector<char> has_value;
     std::vector<double> force;   // spread force per face
-    std::vector<std::int32_t> touched;
-    std::vector<char> mark;      // scratch of stencil(): face already listed
+    std::vector<char> mark;      // face listed (stencil(), cleared there) or touched by spread()
+    std::int32_t lo = std::numeric_limits<std::int32_t>::max(), hi = -1;  // spread()'s marks
   };
   // The 4 × 4 kernel of point (X, Y) on a family: face indices (−1 outside a bounded grid) and
   // weights φ φ.
   void kernel(const Family& f, double X, double Y, std::int32_t idx[16], double w[16]) const;
+  // The kernels of both families at every marker of x into m_idx, m_w (16 per marker and family),
+  // unless they are those of the same x already.
+  void kernels(const std::vector<double>& x) const;
 
   double m_hx, m_hy, m_lx, m_ly;
   Family m_u, m_v;
+  // Cache of kernels(): the markers the kernels belong to, their indices and weights.
+  mutable std::vector<double> m_kernel_x;
+  mutable std::vector<std::int32_t> m_idx;
+  mutable std::vector<double> m_w;
 };
 
 }  // namespace coupler

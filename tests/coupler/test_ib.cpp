@@ -36,6 +36,15 @@ TEST_CASE("Peskin's 4-point kernel: partition of unity and zero first moment") {
   }
 }
 
+TEST_CASE("Peskin's 4-point weights with one square root equal the kernel at the four points") {
+  for (int t = 0; t <= 1000; ++t) {
+    const double r = t < 1000 ? t / 1000.0 : std::nextafter(1.0, 0.0);
+    double w[4];
+    peskin4_weights(r, w);
+    for (int k = 0; k < 4; ++k) CHECK(std::abs(w[k] - peskin4(r + 1 - k)) <= 1e-15);
+  }
+}
+
 TEST_CASE("interpolation is exact for linear fields and, across periodic boundaries, constants") {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> r(0, 1);
