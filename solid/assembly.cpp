@@ -209,42 +209,60 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
 // -m a^(n+1), with a^(n+1) = (v^(n+1) - v^n) / dt the node's acceleration over the step, as an
 // impulse like the coupling force (weight s_d, 2 on dofs with mass). With
 // v_c^(n+1) = s_c (x_c^(n+1) - x_c^n) / dt - [mass] v_c^n,
-//   r_d -= s_d / dt sum_c m_dc (v_c^(n+1) - v_c^n),   K_dc += s_d s_c / dt^2 m_dc
+//   r_d -= s_d / dt sum_c m_dc (v_c^(n+1) - v_c^n),   K_dc += s_d s_c / dt^2 m'_dc
 // (c over the node's two dofs): on a dof with mass exactly the Newmark inertia of a point mass m.
+// The first iteration's tangent takes m' = the previous step's root masses (the current ones on a
+// first step): its matrix then depends on the state at the step's start only, so the look-ahead
+// factorisation (factorize_ahead) serves it. A later iteration that factorises takes the current
+// m (m_tangent_root_mass_now): with a root mass far from the last step's (a fiber's first load)
+// the lagged tangent would not converge.
 void Solver::add_root_mass(Body& B, double dt, bool with_matrix, std::vector<double>& r,
                            std::vector<double>& absm) {
-  if (!m_root_mass || static_cast<int>(m_root_mass->size()) <= B.index) return;
-  const auto& m = (*m_root_mass)[B.index];
-  if (m.empty()) return;
-  if (m.size() != 3 * (B.u.size() / 2))
-    fsi::fail("root masses for body '{}' have {} values, expected 3 per node = {}", B.spec.name,
-              m.size(), 3 * (B.u.size() / 2));
+  const std::size_t nodes = B.u.size() / 2;
+  auto of = [&](const std::vector<std::vector<double>>* list) -> const std::vector<double>* {
+    if (!list || static_cast<int>(list->size()) <= B.index) return nullptr;
+    const auto& m = (*list)[B.index];
+    if (m.empty()) return nullptr;
+    if (m.size() != 3 * nodes)
+      fsi::fail("root masses for body '{}' have {} values, expected 3 per node = {}", B.spec.name,
+                m.size(), 3 * nodes);
+    return &m;
+  };
+  const std::vector<double>* now = of(m_root_mass);
+  const std::vector<double>* tangent = m_tangent_root_mass_now ? now : of(&m_root_mass_tangent);
+  if (!tangent) tangent = now;
   double* values = m_matrix.valuePtr();
-  for (std::size_t a = 0; a < m.size() / 3; ++a) {
-    if (m[3 * a] == 0 && m[3 * a + 1] == 0 && m[3 * a + 2] == 0) continue;
-    const double block[2][2] = {{m[3 * a], m[3 * a + 1]}, {m[3 * a + 1], m[3 * a + 2]}};
-    double sw[2], dv[2], vabs[2];
-    for (int i = 0; i < 2; ++i) {
-      const std::size_t d = 2 * a + i;
-      const bool mass = B.mass_row[d] > 0;
-      sw[i] = mass ? 2.0 : 1.0;
-      const double v = sw[i] * (B.u[d] - B.u_old[d]) / dt - (mass ? B.v_old[d] : 0.0);
-      dv[i] = v - B.v_old[d];
-      vabs[i] = std::abs(v) + std::abs(B.v_old[d]);
+  for (std::size_t a = 0; a < nodes; ++a) {
+    double sw[2];
+    for (int i = 0; i < 2; ++i) sw[i] = B.mass_row[2 * a + i] > 0 ? 2.0 : 1.0;
+    if (now && ((*now)[3 * a] != 0 || (*now)[3 * a + 1] != 0 || (*now)[3 * a + 2] != 0)) {
+      const double* m = &(*now)[3 * a];
+      const double block[2][2] = {{m[0], m[1]}, {m[1], m[2]}};
+      double dv[2], vabs[2];
+      for (int i = 0; i < 2; ++i) {
+        const std::size_t d = 2 * a + i;
+        const double v = sw[i] * (B.u[d] - B.u_old[d]) / dt - (B.mass_row[d] > 0 ? B.v_old[d] : 0.0);
+        dv[i] = v - B.v_old[d];
+        vabs[i] = std::abs(v) + std::abs(B.v_old[d]);
+      }
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j) {
+          r[2 * a + i] -= sw[i] / dt * block[i][j] * dv[j];
+          absm[2 * a + i] += sw[i] / dt * std::abs(block[i][j]) * vabs[j];
+        }
     }
-    for (int i = 0; i < 2; ++i) {
-      const std::size_t d = 2 * a + i;
+    if (!with_matrix || !tangent) continue;
+    const double* m = &(*tangent)[3 * a];
+    if (m[0] == 0 && m[1] == 0 && m[2] == 0) continue;
+    const double block[2][2] = {{m[0], m[1]}, {m[1], m[2]}};
+    for (int i = 0; i < 2; ++i)
       for (int j = 0; j < 2; ++j) {
-        r[d] -= sw[i] / dt * block[i][j] * dv[j];
-        absm[d] += sw[i] / dt * std::abs(block[i][j]) * vabs[j];
-        if (!with_matrix) continue;
-        const int er = B.eq[d], ec = B.eq[2 * a + j];
+        const int er = B.eq[2 * a + i], ec = B.eq[2 * a + j];
         if (er < 0 || ec < 0 || er < ec) continue;
         const int k = matrix_index(er, ec);
         FSI_ASSERT(k >= 0);
         values[k] += sw[i] * sw[j] / (dt * dt) * block[i][j];
       }
-    }
   }
 }
 

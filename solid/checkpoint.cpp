@@ -44,6 +44,7 @@ void SolidProgram::save(fsi::H5File& h5) const {
   fsi::write_vectors(h5, "solid/ma", s.ma);
   fsi::write_vectors(h5, "solid/x", s.x);
   fsi::write_vectors(h5, "solid/contact", s.contact);
+  fsi::write_vectors(h5, "solid/root_mass_tangent", s.root_mass_tangent);
   h5.write("solid/slots", slots_to_numbers(s.slots));
   h5.write("solid/clock", std::vector<double>{s.time, s.contact_force_factor});
   h5.write("solid/counts", std::vector<std::int64_t>{s.step, m_steps, m_repeats, m_newton_total, m_newton_max});
@@ -64,6 +65,7 @@ void SolidProgram::load(const fsi::H5File& h5) {
   s.ma = fsi::read_vectors(h5, "solid/ma");
   s.x = fsi::read_vectors(h5, "solid/x");
   s.contact = fsi::read_vectors(h5, "solid/contact");
+  s.root_mass_tangent = fsi::read_vectors(h5, "solid/root_mass_tangent");
   s.slots = numbers_to_slots(h5.read_doubles("solid/slots"), h5);
   const auto clock = h5.read_doubles("solid/clock");
   s.time = clock.at(0), s.contact_force_factor = clock.at(1);

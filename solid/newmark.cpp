@@ -67,6 +67,8 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
   }
   m_iteration_velocity = nullptr;
   m_root_mass = nullptr;
+  // The next step's tangent (and its look-ahead factorisation) takes this step's root masses.
+  m_root_mass_tangent = root_mass ? *root_mass : std::vector<std::vector<double>>{};
   update_velocity(dt);
   m_time = t1;
   m_step++;

@@ -27,6 +27,11 @@ constexpr double kRoundoffFloor = 1e-12;
 constexpr int kContactsNamed = 8;
 // Residuals of the last iterations a failed step shows.
 constexpr std::size_t kResidualsNamed = 5;
+// A later iteration of a step solves with the factor of an earlier one (modified Newton) while
+// the residual falls by at least this factor per iteration and no contact is in play: the
+// tangent then changes too little within the step to matter (a step of a body whose inertia
+// term 4M/dt^2 dominates its stiffness); a slower fall factorises the current tangent.
+constexpr double kReuseRatio = 1e-2;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -40,7 +45,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 // solved through the factorised K_eff: y0 = K^-1 R, Y = K^-1 B^T, the complementarity problem
 // for lambda with S = B Y, q = g + B y0 (solve_contact), then dx = y0 + Y lambda. The active
 // set is the lambda > 0 of the last iteration. Converged when ||R + B^T lambda|| <= tol, no slot
-// penetrates and every active gap is closed, both within the contact tolerance.
+// penetrates and every active gap is closed, both within the contact tolerance. Iterations after
+// the first keep the factor while Newton contracts fast without it (kReuseRatio).
 StepReport Solver::newton(double c0, double dt, double time_or_factor,
                           const std::vector<std::vector<double>>* external,
                           const std::string& when) {
@@ -54,6 +60,7 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
 
   for (int it = 0;; ++it) {
     auto t0 = clock::now();
+    m_tangent_root_mass_now = it > 0;  // add_root_mass: the first tangent takes the last step's
     assemble_iterate(c0, dt, time_or_factor, external, it > 0, dx, when);
     rep.assembly_seconds += seconds_since(t0);
     const ContactLinearisation contact = linearise_contact(c0, dt, time_or_factor, external);
@@ -68,10 +75,15 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
       break;
     }
     if (it >= st.newton_max_iterations) break;
+    const bool reuse =
+        it > 0 && contact.candidates.empty() && rn <= kReuseRatio * previous && m_factored_valid;
     previous = rn;
 
     t0 = clock::now();
-    factorize(when);
+    if (reuse)
+      ++m_factor_reuses;
+    else
+      factorize(when);
     rep.factor_seconds += seconds_since(t0);
     t0 = clock::now();
     dx = m_linear.solve(m_residual);
@@ -81,6 +93,7 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
     rep.iterations++;
   }
 
+  m_tangent_root_mass_now = false;
   store_contact_forces();
   if (!rep.converged && contact_active_or_open) fail_contact_not_converged(rep, when, gap_tol);
   if (!rep.converged) fail_not_converged(rep, when);

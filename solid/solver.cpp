@@ -167,6 +167,7 @@ void Solver::save_state(StepState& s) const {
   s.time = m_time;
   s.step = m_step;
   s.contact_force_factor = m_contact_force_factor;
+  s.root_mass_tangent = m_root_mass_tangent;
 }
 
 void Solver::restore_state(const StepState& s) {
@@ -179,6 +180,7 @@ void Solver::restore_state(const StepState& s) {
   m_time = s.time;
   m_step = s.step;
   m_contact_force_factor = s.contact_force_factor;
+  m_root_mass_tangent = s.root_mass_tangent;
   m_dirichlet_pending = false;
 }
 

@@ -43,6 +43,7 @@ struct Modes {
 // multipliers), the clock. Opaque outside the solver.
 struct StepState {
   std::vector<std::vector<double>> u, v, ma, x, contact;
+  std::vector<std::vector<double>> root_mass_tangent;  // the root masses the tangent takes
   std::vector<ContactSlot> slots;
   double time = 0;
   long step = 0;
@@ -219,6 +220,9 @@ class Solver {
   bool m_dirichlet_pending = false;   // a prescribed increment awaits the first Newton solve
   const std::vector<std::vector<double>>* m_iteration_velocity = nullptr;  // during advance()
   const std::vector<std::vector<double>>* m_root_mass = nullptr;            // during advance()
+  // The root masses in the tangent: those of the previous step (assembly.cpp, add_root_mass).
+  std::vector<std::vector<double>> m_root_mass_tangent;
+  bool m_tangent_root_mass_now = false;  // later Newton iterations: the tangent takes the current
 };
 
 }  // namespace solid
