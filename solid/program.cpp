@@ -31,7 +31,11 @@ SolidProgram::SolidProgram(fsi::Runtime& rt)
     : m_rt(rt),
       m_cfg(read_config(rt.root().table("solid"), fluid_density_of(rt))),
       m_h5(fsi::output_h5(rt, rt.out_dir() / "solid.h5")) {
-  m_solver = std::make_unique<Solver>(m_cfg.model);
+  try {
+    m_solver = std::make_unique<Solver>(m_cfg.model);
+  } catch (const fsi::InputError& e) {  // the model's checks know no file: name it
+    throw fsi::InputError(fmt::format("{} (in {})", e.what(), rt.scene().file().string()));
+  }
   const Solver& s = *m_solver;
   for (int b = 0; b < s.num_bodies(); ++b) {
     const Mesh& m = s.mesh(b);

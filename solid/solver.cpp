@@ -46,6 +46,34 @@ Solver::Solver(Model model, LinearSolver::Backend backend)
   m_contact.setup(meshes, kinds, m_model.contacts, m_model.planes);
   update_rigid(0);
   update_prescribed(0);
+  check_initial_overlap();
+}
+
+// Bodies of a contact pair (or a body and a contact plane) that overlap at t = 0 by more than
+// the contact tolerance have no admissible start: the first step would throw them apart with an
+// arbitrary impulse. The deepest node of each pair is named.
+void Solver::check_initial_overlap() {
+  if (m_contact.empty()) return;
+  std::vector<const std::vector<double>*> xs;
+  std::vector<double> reach;
+  for (const auto& b : m_bodies) xs.push_back(&b->x), reach.push_back(b->min_edge);
+  m_contact.detect(xs, reach);
+  const double tol = contact_gap_tolerance();
+  const ContactSlot* worst = nullptr;
+  for (const auto& s : m_contact.slots())
+    if (s.gap < -tol && (!worst || s.gap < worst->gap)) worst = &s;
+  if (!worst) return;
+  const Body& S = *m_bodies[worst->slave_body];
+  const std::string other = worst->master_body < 0
+                                ? fmt::format("contact plane {}", worst->plane)
+                                : fmt::format("body '{}'", m_bodies[worst->master_body]->spec.name);
+  throw fsi::InputError(fmt::format(
+      "body '{}' and {} overlap at t = 0: node {} of '{}' at ({:.6g}, {:.6g}) is {:.3g} inside "
+      "{}, beyond the contact tolerance {:.3g} ([solid] contact_tolerance = {:g} of the "
+      "smallest surface edge): move the bodies apart (their meshes, a clearance)",
+      S.spec.name, other, worst->slave_node, S.spec.name, S.x[2 * worst->slave_node],
+      S.x[2 * worst->slave_node + 1], -worst->gap, other, tol,
+      m_model.settings.contact_tolerance));
 }
 
 int Solver::body_index(const std::string& name) const {

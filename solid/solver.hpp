@@ -162,6 +162,7 @@ class Solver {
                                const std::vector<std::vector<double>>* external);
   void add_root_mass(Body& B, double dt, bool with_matrix, std::vector<double>& r,
                      std::vector<double>& absm);
+  void check_initial_overlap();
   // Newton on the step's residual with contact (newton.cpp) and its parts.
   StepReport newton(double c0, double dt, double load_factor,
                     const std::vector<std::vector<double>>* external, const std::string& when);
