@@ -136,6 +136,49 @@ point = [{cx - 0.2!r}, {cy - SLAB / 2!r}]
 """
 
 
+def hydrostatic(name, ny):
+    """A closed box [0, 1]^2 at rest under the body force (0, -G) with a block turned by 30
+    degrees in it: p = -G y + c; the probes' pressures at two points of its top face differ by
+    -G (y_1 - y_0). The incremental projection starts from p = 0: the first steps stir the fluid
+    (the forcing takes the body force inside the block away) and it comes to rest in the
+    hydrostatic state."""
+    h = 1.0 / ny
+    th = math.radians(30.0)
+    c, s = math.cos(th), math.sin(th)
+    w, hb, cx, cy = 0.4, 0.2, 0.5, 0.4
+    # probe points in the reference (unturned) configuration; pts where they are once turned
+    ref = [(cx + d, cy + 0.5 * hb) for d in (-0.12, 0.12)]
+    pts = [(cx + d * c - 0.5 * hb * s, cy + d * s + 0.5 * hb * c) for d in (-0.12, 0.12)]
+    probes = "".join(f"""[[coupler.surface_probe]]
+name = "P{k}"
+body = "block"
+point = [{x!r}, {y!r}]
+""" for k, (x, y) in enumerate(ref))
+    return header(name, h, 0.5) + f"""[fluid]
+density = 1.0
+viscosity = {MU}
+[fluid.grid]
+cells = [{ny}, {ny}]
+size = [1.0, 1.0]
+[fluid.boundary]
+left = {{ type = "wall" }}
+right = {{ type = "wall" }}
+bottom = {{ type = "wall" }}
+top = {{ type = "wall" }}
+[fluid.forcing]
+body = [0.0, {-G!r}]
+[solid]
+[[solid.body]]
+name = "block"
+kind = "rigid"
+rectangle = {{ origin = [{cx - w / 2!r}, {cy - hb / 2!r}], size = [{w!r}, {hb!r}], cells = [8, 4] }}
+[solid.body.motion]
+center = [{cx}, {cy}]
+angle = {th!r}
+phase = {math.pi / 2!r}
+""" + probes, pts
+
+
 def exact(case, y0):
     if case == "couette":
         return MU * U_TOP / (0.5 - y0)
@@ -200,6 +243,19 @@ def main():
     for key, ny, h, vals, ref, err, slip, y0 in rows:
         print(f"| {key} | {ny} | {h:.5g} | {'-' if y0 is None else format(y0, '.6g')} | "
               f"{', '.join(f'{v:.5g}' for v in vals)} | {ref:.5g} | {err:.3e} | {slip:.2e} |")
+    # The pressure: hydrostatic, exact for a linear p (at rest the fluid's p is the hydrostatic
+    # one to round-off, and the probe's extrapolation is exact for it).
+    for ny in GRIDS:
+        text, pts = hydrostatic(f"hydrostatic-{ny}", ny)
+        r = job.run(f"hydrostatic-{ny}", text, work=os.path.join(OUT, "runs"))
+        t = table(os.path.join(r.folder, "coupler_surface.csv"))
+        dp = t["P1.p"][-1] - t["P0.p"][-1]
+        ref = -G * (pts[1][1] - pts[0][1])
+        err = abs(dp - ref) / abs(ref)
+        results[f"hydrostatic-{ny}"] = {"dp": dp, "exact": ref, "relative_error": err}
+        print(f"[surface-probes] hydrostatic ny = {ny}: p difference {dp:.9g} (exact {ref:.9g}), "
+              f"relative error {err:.2e}", flush=True)
+        metrics[f"pressure_difference_error_{ny}"] = at_most(err, 1e-6)
     finish("surface-probes", metrics, {"runs": results, "grids": GRIDS}, short=SHORT,
            per_run=per_run, reference="exact plane Couette and Poiseuille solutions")
 
