@@ -9,7 +9,8 @@ driving (T = 1.2); statistics over the last --last periods:
   amplitude (max - min)/2) and the pressure's amplitude, from [[coupler.surface_probe]];
 - the flow rate through x = 1/2 (amplitude and mean);
 - the fluid velocity at D (centre line above C) and the wall's velocity at C: their amplitudes
-  and their phases at the driving frequency, against that of the flow rate;
+  and their phases at the driving frequency, against that of the flow rate (whose own phase is
+  given against the driving force);
 and the paper's findings as reported (not judged) yes/no: fibers lower the WSS at C, the elastic
 wall lowers it further, fibers raise the pressure fluctuation at C, fibers lower the flow-rate
 fluctuation, the wall moves in phase with the pulsation. --sweep adds the elastic wall with
@@ -85,6 +86,8 @@ def statistics(folder, elastic, t_end, last):
            "flow_rate_mean": float(np.mean(q["Q0"][wq])), "flow_rate_amplitude": amplitude(q["Q0"][wq]),
            "u_D_amplitude": amplitude(d["D.ux"][wd])}
     phi_q = phase(q["time"][wq], q["Q0"][wq])
+    # against the driving sin(wt), whose phase by phase() is -pi/2
+    out["flow_rate_phase_deg"] = math.degrees(wrap(phi_q + math.pi / 2))
     out["u_D_phase_deg"] = math.degrees(wrap(phase(d["time"][wd], d["D.ux"][wd]) - phi_q))
     if elastic:
         c = table(os.path.join(folder, "solid_probes.csv"))
@@ -92,6 +95,41 @@ def statistics(folder, elastic, t_end, last):
         out["wall_v_C_amplitude"] = amplitude(c["C.vx"][wc])
         out["wall_v_C_phase_deg"] = math.degrees(wrap(phase(c["time"][wc], c["C.vx"][wc]) - phi_q))
     return out
+
+
+def plots(folders, t_end, last):
+    """Figs. 19, 20, 22 of the paper: p and tau at C, u at D and the wall's velocity at C, the
+    flow rate, over the last periods of each variant (glycocalyx.png)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
+    for v, (folder, elastic) in folders.items():
+        s = table(os.path.join(folder, "coupler_surface.csv"))
+        q = table(os.path.join(folder, "fluid_flow_rate.csv"))
+        d = table(os.path.join(folder, "fluid_probes.csv"))
+        w = window(s["time"], t_end, last)
+        ax[0, 0].plot(s["time"][w], s["C.p"][w] - np.mean(s["C.p"][w]), label=v)
+        ax[0, 1].plot(s["time"][w], s["C.tau"][w], label=v)
+        wq = window(q["time"], t_end, last)
+        ax[1, 0].plot(q["time"][wq], q["Q0"][wq], label=v)
+        wd = window(d["time"], t_end, last)
+        line, = ax[1, 1].plot(d["time"][wd], d["D.ux"][wd], label=f"{v}: u at D")
+        if elastic:
+            c = table(os.path.join(folder, "solid_probes.csv"))
+            wc = window(c["time"], t_end, last)
+            ax[1, 1].plot(c["time"][wc], 10 * c["C.vx"][wc], "--", color=line.get_color(),
+                          label=f"{v}: 10 x wall v_x at C")
+    for a, title in zip(ax.flat, ["pressure at C (minus its mean)", "wall shear stress at C",
+                                  "flow rate through x = 1/2", "velocity at D, wall at C"]):
+        a.set_title(title)
+        a.grid(alpha=0.3)
+        a.legend(fontsize=7)
+    for a in ax[1]:
+        a.set_xlabel("t")
+    fig.tight_layout()
+    fig.savefig(os.path.join(OUT, "glycocalyx.png"), dpi=110)
+    plt.close(fig)
 
 
 def short():
@@ -118,7 +156,7 @@ def main():
         return short()
     periods, last = ARGS.periods, min(ARGS.last, ARGS.periods)
     t_end = periods * T
-    results, metrics = {}, {}
+    results, metrics, folders = {}, {}, {}
     for v in ARGS.variants.split(","):
         if v not in VARIANTS:
             raise SystemExit(f"--variants: unknown variant '{v}' (of {', '.join(VARIANTS)})")
@@ -126,24 +164,29 @@ def main():
         r = run(f"{v}", elastic, fibers, periods)
         results[v] = statistics(r.folder, elastic, t_end, last)
         results[v]["wall_s"] = r.wall
+        folders[v] = (r.folder, elastic)
         print(f"{v}: " + ", ".join(f"{k} {x:.4g}" for k, x in results[v].items()), flush=True)
         for k, x in results[v].items():
             metrics[f"{v}.{k}"] = reported(x)
     r = results
     findings = []
-    if "rigid" in r and "rigid-fibers" in r:
-        findings += [("fibers_lower_wss_amplitude_at_C",
-                      r["rigid-fibers"]["tau_amplitude"] < r["rigid"]["tau_amplitude"]),
-                     ("fibers_raise_pressure_fluctuation_at_C",
-                      r["rigid-fibers"]["p_amplitude"] > r["rigid"]["p_amplitude"]),
-                     ("fibers_lower_flow_rate_fluctuation",
-                      r["rigid-fibers"]["flow_rate_amplitude"] < r["rigid"]["flow_rate_amplitude"])]
+    for wall in ("rigid", "elastic"):
+        bare, fib = r.get(wall), r.get(f"{wall}-fibers")
+        if not (bare and fib):
+            continue
+        findings += [(f"fibers_lower_wss_amplitude_at_C_{wall}",
+                      fib["tau_amplitude"] < bare["tau_amplitude"]),
+                     (f"fibers_raise_pressure_fluctuation_at_C_{wall}",
+                      fib["p_amplitude"] > bare["p_amplitude"]),
+                     (f"fibers_lower_flow_rate_fluctuation_{wall}",
+                      fib["flow_rate_amplitude"] < bare["flow_rate_amplitude"])]
     if "rigid-fibers" in r and "elastic-fibers" in r:
         findings.append(("elastic_wall_lowers_wss_amplitude_further",
                          r["elastic-fibers"]["tau_amplitude"] < r["rigid-fibers"]["tau_amplitude"]))
-    if "elastic-fibers" in r:
-        findings.append(("wall_moves_in_phase_with_flow",
-                         abs(r["elastic-fibers"]["wall_v_C_phase_deg"]) < 30.0))
+    for v in ("elastic", "elastic-fibers"):
+        if v in r:
+            findings.append((f"wall_moves_in_phase_with_flow_{v}",
+                             abs(r[v]["wall_v_C_phase_deg"]) < 30.0))
     for k, ok in findings:
         metrics[k] = reported(float(ok))
         print(f"  {k}: {'yes' if ok else 'no'}")
@@ -155,6 +198,7 @@ def main():
         sweep[e]["wall_s"] = rr.wall
         metrics[f"sweep_E{e:g}.flow_rate_amplitude"] = reported(sweep[e]["flow_rate_amplitude"])
         print(f"E = {e:g}: flow-rate amplitude {sweep[e]['flow_rate_amplitude']:.5g}", flush=True)
+    plots(folders, t_end, last)
     print("\n| variant | tau mean at C | tau amplitude | p amplitude at C | flow-rate amplitude | "
           "wall v at C, phase | wall s |")
     print("|---|---|---|---|---|---|---|")
