@@ -253,7 +253,8 @@ void Coupler::commit(long n) {
       if (m_meshes.bodies[b].kind != proto::BodyKind::elastic) before[b].clear();
     m_log->before_root_loads(before);
     root_poses(m_start, m_log_poses);
-    m_log->root_loads(m_solid_in.force, root_loads_without_inertia(), m_log_poses);
+    m_log->root_loads(m_solid_in.force, root_loads_without_inertia(), m_log_poses,
+                      m_fiber.root_mass, m_solid_in.root_mass);
   }
   write_force_probes(n, m_start, m_reaction);
   write_surface_probes(n);

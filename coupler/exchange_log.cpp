@@ -114,7 +114,11 @@ void ExchangeLog::before_root_loads(const std::vector<std::vector<double>>& forc
 // The root loads as nodal forces: what add_root_loads() changed, per body and node.
 void ExchangeLog::root_loads(const std::vector<std::vector<double>>& force,
                              const std::vector<double>& root_load,
-                             const std::vector<std::vector<double>>& poses) {
+                             const std::vector<std::vector<double>>& poses,
+                             const std::vector<double>& root_mass,
+                             const std::vector<std::vector<double>>& nodal_root_mass) {
+  m_root_mass = root_mass;
+  m_nodal_root_mass = nodal_root_mass;
   for (std::size_t b = 0; b < force.size() && b < m_root_nodal.size(); ++b) {
     auto& d = m_root_nodal[b];
     if (d.empty()) d.assign(force[b].size(), 0.0);
@@ -216,6 +220,7 @@ void ExchangeLog::dump() {
     put(g + "v", m_solid.v[b]);
     if (b < m_reaction.size()) put(g + "reaction", m_reaction[b]);
     if (b < m_root_nodal.size()) put(g + "root_force", m_root_nodal[b]);
+    if (b < m_nodal_root_mass.size()) put(g + "root_mass", m_nodal_root_mass[b]);
   }
   for (std::size_t k = 0; k < m_layout.fibers.size() && k < m_fiber.x.size(); ++k) {
     const std::string g = "fiber_" + m_layout.fibers[k].name + "/";
@@ -226,6 +231,8 @@ void ExchangeLog::dump() {
     if (k < m_poses.size()) put(g + "root_pose", m_poses[k]);
     if (3 * k + 2 < m_root_load.size())
       h.write(s + "/" + g + "root_load", std::span(m_root_load).subspan(3 * k, 3));
+    if (3 * k + 2 < m_root_mass.size())
+      h.write(s + "/" + g + "root_mass", std::span(m_root_mass).subspan(3 * k, 3));
   }
 }
 

@@ -38,9 +38,12 @@ class ExchangeLog {
   // ... the nodal forces just before and just after the fibers' root loads are added, the root
   // loads and the root poses (x, y, dx, dy per attached fiber, empty otherwise) at tⁿ ...
   void before_root_loads(const std::vector<std::vector<double>>& force);
+  // (and the fibers' root masses, lumped on the nodes as the solid gets them)
   void root_loads(const std::vector<std::vector<double>>& force,
                   const std::vector<double>& root_load,
-                  const std::vector<std::vector<double>>& poses);
+                  const std::vector<std::vector<double>>& poses,
+                  const std::vector<double>& root_mass,
+                  const std::vector<std::vector<double>>& nodal_root_mass);
   // ... and the end of the step: one CSV row, the dump when due.
   void end_step();
 
@@ -67,7 +70,8 @@ class ExchangeLog {
   proto::FluidInput m_in;
   proto::FluidOutput m_out;
   std::vector<std::vector<double>> m_u_markers, m_fiber_force, m_reaction, m_root_nodal, m_poses;
-  std::vector<double> m_root_load;
+  std::vector<double> m_root_load, m_root_mass;
+  std::vector<std::vector<double>> m_nodal_root_mass;
   std::vector<std::int32_t> m_sample_u, m_sample_v, m_prev_sample_u, m_prev_sample_v;
   std::vector<double> m_value_u, m_value_v, m_prev_value_u, m_prev_value_v;
   std::vector<double> m_row;

@@ -23,7 +23,9 @@ dump_every > 0) and scene.effective.toml. Checks (each over every dumped step fr
   fiber-forces  Σ f_f h_x h_y (on the fluid) = −Σ_m F_m w_m (on the fibers; w = ds, ds/2 at the
                 ends), relative to Σ |F| w (which must be > 0).
   root-loads    the nodal forces that carry each fiber's root load to its body have the load's
-                resultant and, about the root point, its moment; relative to |F| + |M|/L.
+                resultant and, about the root point, its moment; relative to |F| + |M|/L. The
+                root masses lumped on the nodes sum to the fibers' and have their first moment
+                about the root points (sum x_a m_a = sum p m); relative to |m| (|m| L).
 
 Prints each check's worst relative error; exits 1 when one exceeds --tol (default 1e-12) or a
 check had nothing to check.
@@ -364,6 +366,33 @@ def check_root_loads(run, steps):
             err = max(np.abs(force - load[:2]).max(), abs(moment - load[2]) / length) / scale
             yield s, err, (f"fiber {f}: load ({load[0]:.6g}, {load[1]:.6g}, M {load[2]:.6g}), nodal "
                            f"({force[0]:.6g}, {force[1]:.6g}, M {moment:.6g})")
+        yield from check_root_masses(run, s)
+
+
+def check_root_masses(run, s):
+    """Sum over the nodes of the lumped root masses = sum over the fibers, and the same first
+    moment about the origin (the lumping (1 - s) m at a, s m at b keeps the root point)."""
+    fib, fib_moment = np.zeros(3), np.zeros((2, 3))
+    for f in run.fibers:
+        if f"fiber_{f}/root_pose" not in run.h5[s] or f"fiber_{f}/root_mass" not in run.h5[s]:
+            continue
+        m = run.get(s, f"fiber_{f}/root_mass")
+        p = run.get(s, f"fiber_{f}/root_pose")[:2]
+        fib += m
+        fib_moment += np.outer(p, m)
+    nodal, nodal_moment = np.zeros(3), np.zeros((2, 3))
+    for b in run.bodies:
+        if f"body_{b}/root_mass" not in run.h5[s]:
+            continue
+        mm = run.get(s, f"body_{b}/root_mass").reshape(-1, 3)
+        x = run.get(s, f"body_{b}/x").reshape(-1, 2)
+        nodal += mm.sum(axis=0)
+        nodal_moment += x.T @ mm
+    scale = np.abs(fib).max()
+    if scale == 0:
+        return
+    err = max(np.abs(nodal - fib).max(), np.abs(nodal_moment - fib_moment).max()) / scale
+    yield s, err, f"root mass: fibers {fib}, nodes {nodal}"
 
 
 def main():
