@@ -78,12 +78,14 @@ void FeedbackIB::kernel(const Family& f, double X, double Y, std::int32_t idx[16
     }
 }
 
-// Each face is marked once; the list is read off the marks between the smallest and the largest
-// marked index, which gives it sorted without a sort (the faces of a fiber layer lie in a band of
-// rows: a few times the listed faces to scan).
+// Each face is marked once and listed; where the marks lie in a narrow index range (the faces of a
+// fiber layer in a band of rows) the sorted list is read off them, else the list is sorted (fibers
+// far apart in y, or across a periodic y boundary): the cost follows the footprint, not the grid.
+// Needs no spread() pending (feedback_forces takes the spread before asking for the stencil).
 void FeedbackIB::stencil(const std::vector<std::vector<double>>& markers, int margin,
                          std::vector<std::int32_t>& u_faces, std::vector<std::int32_t>& v_faces) {
   for (auto [f, out] : {std::pair{&m_u, &u_faces}, std::pair{&m_v, &v_faces}}) {
+    FSI_ASSERT(f->hi < 0);  // no spread() waiting for take_spread()
     out->clear();
     std::int32_t lo = std::numeric_limits<std::int32_t>::max(), hi = -1;
     for (const auto& x : markers) {
@@ -103,15 +105,32 @@ void FeedbackIB::stencil(const std::vector<std::vector<double>>& markers, int ma
             if (f->px) a = ((a % f->ni) + f->ni) % f->ni;
             else if (a < 0 || a >= f->ni) continue;
             const std::int32_t k = a + f->ni * b;
+            if (f->mark[k]) continue;
             f->mark[k] = 1;
+            out->push_back(k);
             lo = std::min(lo, k), hi = std::max(hi, k);
           }
         }
       }
     }
-    for (std::int32_t k = lo; k <= hi; ++k)
-      if (f->mark[k]) out->push_back(k), f->mark[k] = 0;
+    scan_or_sort(f->mark, lo, hi, *out);
   }
+}
+
+// The marked indices (listed in `list` in any order) sorted, and their marks cleared: read off the
+// marks from lo to hi when that range is at most kScanFactor times the list, else sorted.
+void FeedbackIB::scan_or_sort(std::vector<char>& mark, std::int32_t lo, std::int32_t hi,
+                              std::vector<std::int32_t>& list) {
+  constexpr std::int64_t kScanFactor = 8;
+  if (list.empty()) return;
+  if (std::int64_t(hi) - lo + 1 <= kScanFactor * std::int64_t(list.size())) {
+    list.clear();
+    for (std::int32_t k = lo; k <= hi; ++k)
+      if (mark[k]) list.push_back(k), mark[k] = 0;
+    return;
+  }
+  std::sort(list.begin(), list.end());
+  for (const std::int32_t k : list) mark[k] = 0;
 }
 
 void FeedbackIB::store_samples(const std::vector<std::int32_t>& u_faces, const std::vector<double>& u,
@@ -171,7 +190,7 @@ void FeedbackIB::spread(const std::vector<double>& x, const std::vector<double>&
       const double* w = &m_w[16 * m + 16 * c];
       for (int k = 0; k < 16; ++k) {
         if (idx[k] < 0 || w[k] == 0) continue;
-        f.mark[idx[k]] = 1;
+        if (!f.mark[idx[k]]) f.mark[idx[k]] = 1, f.touched.push_back(idx[k]);
         f.lo = std::min(f.lo, idx[k]), f.hi = std::max(f.hi, idx[k]);
         f.force[idx[k]] += scale * F[m + c] * w[k];
       }
@@ -179,15 +198,17 @@ void FeedbackIB::spread(const std::vector<double>& x, const std::vector<double>&
   }
 }
 
-// The touched faces read off their marks in index order (sorted, as stencil()).
+// The touched faces in index order (as stencil()) with their forces, then cleared.
 void FeedbackIB::take_spread(proto::FaceForce& u, proto::FaceForce& v) {
   for (auto [f, out] : {std::pair{&m_u, &u}, std::pair{&m_v, &v}}) {
-    out->index.clear(), out->force.clear();
-    for (std::int32_t k = f->lo; k <= f->hi; ++k) {
-      if (!f->mark[k]) continue;
-      out->index.push_back(k), out->force.push_back(f->force[k]);
-      f->force[k] = 0, f->mark[k] = 0;
+    scan_or_sort(f->mark, f->lo, f->hi, f->touched);
+    out->index = f->touched;
+    out->force.resize(f->touched.size());
+    for (std::size_t k = 0; k < f->touched.size(); ++k) {
+      out->force[k] = f->force[f->touched[k]];
+      f->force[f->touched[k]] = 0;
     }
+    f->touched.clear();
     f->lo = std::numeric_limits<std::int32_t>::max(), f->hi = -1;
   }
 }

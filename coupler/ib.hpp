@@ -68,7 +68,8 @@ class FeedbackIB {
     std::vector<char> has_value;
     std::vector<double> force;   // spread force per face
     std::vector<char> mark;      // face listed (stencil(), cleared there) or touched by spread()
-    std::int32_t lo = std::numeric_limits<std::int32_t>::max(), hi = -1;  // spread()'s marks
+    std::vector<std::int32_t> touched;  // spread()'s faces, until take_spread()
+    std::int32_t lo = std::numeric_limits<std::int32_t>::max(), hi = -1;  // their index range
   };
   // The 4 × 4 kernel of point (X, Y) on a family: face indices (−1 outside a bounded grid) and
   // weights φ φ.
@@ -76,6 +77,8 @@ class FeedbackIB {
   // The kernels of both families at every marker of x into m_idx, m_w (16 per marker and family),
   // unless they are those of the same x already.
   void kernels(const std::vector<double>& x) const;
+  static void scan_or_sort(std::vector<char>& mark, std::int32_t lo, std::int32_t hi,
+                           std::vector<std::int32_t>& list);
 
   double m_hx, m_hy, m_lx, m_ly;
   Family m_u, m_v;

@@ -42,8 +42,9 @@ struct SurfaceProbeSpec {
 // for an exact no-slip wall; it measures where the flow sees the wall), and the pressure
 //   p = (d_1 p(q_0) − d_0 p(q_1)) / (d_1 − d_0),  p(q_k) bilinear in the cell centres,
 // the line through the two nearest fluid points extrapolated to the surface: exact for a linear
-// pressure, O(h^2) where p is smooth (at a no-slip wall dp/dn = mu d^2 u_n/dn^2 stays finite);
-// the pressure inside the body and in the cells the interface cuts is not used.
+// pressure (away from a domain wall: within half a cell of one the nearest row's value is taken),
+// O(h^2) where p is smooth (at a no-slip wall dp/dn = mu d^2 u_n/dn^2 stays finite); on a flat
+// surface the pressure inside the body and in the cells the interface cuts is not used.
 class SurfaceProbes {
  public:
   // The probes' edges on the bodies' reference surfaces. An unknown body, or a point farther

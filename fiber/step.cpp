@@ -4,6 +4,8 @@
 // time step when the explicit bending limit asks for it.
 #include <fmt/format.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <chrono>
 #include <cmath>
 
@@ -278,7 +280,11 @@ void FiberSystem::end_loads(int k, double h) {
 // the first pivot of J eliminated from the last row upwards (its Schur complement). The bending
 // forces' dependence on the root (a stiffness, O(h^2) against the inertia) is left out. For a
 // straight fiber, J^-1 makes the whole chain follow the root along its axis: mass ~ the fiber's
-// mass along it, m_0 across.
+// mass along it, m_0 across. A first segment that turns fast within the sub-step (by more than
+// about sqrt(2 / markers) rad) would make the symmetrised block indefinite; its eigenvalues are
+// kept >= m_0, the end marker's own mass, so that the support always receives a positive mass.
+// On the very first sub-step c holds theta = 1/2 (the start from rest), which doubles the mass
+// along the fiber for that step only.
 Eigen::Matrix2d FiberSystem::root_mass(int k, double h) const {
   const Fiber& s = m_fibers[k];
   const int n = s.segments;
@@ -287,9 +293,16 @@ Eigen::Matrix2d FiberSystem::root_mass(int k, double h) const {
   for (int j = n - 2; j >= 0; --j) pivot = m_di[o + j] - m_up[o + j] * m_lo[o + j + 1] / pivot;
   const Vec2 r0 = at(m_ref, o);
   const Vec2 d0 = at(m_x_new, s.offset + 1) - at(m_x_new, s.offset);
-  const Eigen::Matrix2d m = m_mass[s.offset] * Eigen::Matrix2d::Identity() -
-                            (2 * h * h / (pivot * s.ds)) * (r0 * d0.transpose());
-  return 0.5 * (m + m.transpose());
+  const double m0 = m_mass[s.offset];
+  Eigen::Matrix2d m = m0 * Eigen::Matrix2d::Identity() -
+                      (2 * h * h / (pivot * s.ds)) * (r0 * d0.transpose());
+  m = 0.5 * (m + m.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(m);
+  if (eig.eigenvalues()(0) < m0) {
+    const Eigen::Vector2d lam = eig.eigenvalues().cwiseMax(m0);
+    m = eig.eigenvectors() * lam.asDiagonal() * eig.eigenvectors().transpose();
+  }
+  return m;
 }
 
 // Load on the driver of a prescribed fiber: sum_i (f_i - m_i a_i) with f_i = m_i g +

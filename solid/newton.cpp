@@ -28,7 +28,9 @@ constexpr int kContactsNamed = 8;
 // Residuals of the last iterations a failed step shows.
 constexpr std::size_t kResidualsNamed = 5;
 // A later iteration of a step solves with the factor of an earlier one (modified Newton) while
-// the residual falls by at least this factor per iteration and no contact is in play: the
+// the residual falls by at least this factor per iteration and this iteration has no contact
+// candidates (the reused factor may still hold an earlier iteration's contact curvature, which
+// costs convergence speed only): the
 // tangent then changes too little within the step to matter (a step of a body whose inertia
 // term 4M/dt^2 dominates its stiffness); a slower fall factorises the current tangent.
 constexpr double kReuseRatio = 1e-2;
