@@ -143,9 +143,8 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
         double sw[6], dv[6], vabs[6];  // vabs: |v| + |w|, the scale of the terms that cancel
         for (int c = 0; c < 6; ++c) {
           const int d = 2 * t[c / 2] + c % 2;
-          const bool mass = B.mass_row[d] > 0;
-          sw[c] = mass ? 2.0 : 1.0;
-          const double v = sw[c] * (B.u[d] - B.u_old[d]) / dt - (mass ? B.v_old[d] : 0.0);
+          sw[c] = B.impulse_weight(d);
+          const double v = B.step_velocity(d, dt);
           dv[c] = v - (*iter_w)[d];
           vabs[c] = std::abs(v) + std::abs((*iter_w)[d]);
         }
@@ -234,14 +233,14 @@ void Solver::add_root_mass(Body& B, double dt, bool with_matrix, std::vector<dou
   double* values = m_matrix.valuePtr();
   for (std::size_t a = 0; a < nodes; ++a) {
     double sw[2];
-    for (int i = 0; i < 2; ++i) sw[i] = B.mass_row[2 * a + i] > 0 ? 2.0 : 1.0;
+    for (int i = 0; i < 2; ++i) sw[i] = B.impulse_weight(2 * a + i);
     if (now && ((*now)[3 * a] != 0 || (*now)[3 * a + 1] != 0 || (*now)[3 * a + 2] != 0)) {
       const double* m = &(*now)[3 * a];
       const double block[2][2] = {{m[0], m[1]}, {m[1], m[2]}};
       double dv[2], vabs[2];
       for (int i = 0; i < 2; ++i) {
         const std::size_t d = 2 * a + i;
-        const double v = sw[i] * (B.u[d] - B.u_old[d]) / dt - (B.mass_row[d] > 0 ? B.v_old[d] : 0.0);
+        const double v = B.step_velocity(d, dt);
         dv[i] = v - B.v_old[d];
         vabs[i] = std::abs(v) + std::abs(B.v_old[d]);
       }
