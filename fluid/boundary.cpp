@@ -33,7 +33,8 @@ Boundaries::Boundaries(const Grid& g, const std::array<SideBc, 4>& bc) : m_g(g),
     switch (bc[s].type) {
       case BcType::wall:
       case BcType::inflow: m_rule[s] = quadratic_rule(w0, w1); break;
-      case BcType::slip: m_rule[s] = {1, 0, 0, false}; break;
+      case BcType::slip:
+      case BcType::pressure: m_rule[s] = {1, 0, 0, false}; break;
       case BcType::outflow:
         m_rule[s] = {0, 0, 0, true};
         m_has_outflow = true;
@@ -45,12 +46,7 @@ Boundaries::Boundaries(const Grid& g, const std::array<SideBc, 4>& bc) : m_g(g),
 
 double Boundaries::inflow(int s, double coord, double t) const {
   const SideBc& b = m_bc[s];
-  double ramp = 1;
-  if (b.ramp == Ramp::cosine && t < b.ramp_time) {
-    ramp = 0.5 * (1 - std::cos(std::numbers::pi * t / b.ramp_time));
-  } else if (b.ramp == Ramp::linear && t < b.ramp_time) {
-    ramp = t / b.ramp_time;
-  }
+  const double ramp = b.ramp_factor(t);
   if (b.profile == Profile::uniform) return ramp * b.mean;
   const Axis& o = m_g.axis(1 - s / 2);
   const double lo = o.lo(), len = o.length();
@@ -82,7 +78,7 @@ void Boundaries::advance_normal(Field& u, Field& v, double t, double dt) {
   double out_length = 0;
   for (int s = 0; s < 4; ++s) {
     const SideBc& bc = m_bc[s];
-    if (bc.type == BcType::periodic) continue;
+    if (bc.type == BcType::periodic || bc.type == BcType::pressure) continue;  // pressure: the solver's
     const int a = s / 2;
     const bool hi = s % 2;
     const Axis& ax = m_g.axis(a);
@@ -190,12 +186,13 @@ void Boundaries::fill_ghosts(Field& u, Field& v) const {
   }
 }
 
-void Boundaries::fill_scalar(Field& p) const {
+void Boundaries::fill_scalar(Field& p, const std::array<double, 4>& face) const {
   const int nx = m_g.nx(), ny = m_g.ny();
   const bool px = m_bc[left].type == BcType::periodic, py = m_bc[bottom].type == BcType::periodic;
+  const bool dl = is_pressure(left), dr = is_pressure(right);
   for (int j = 0; j < ny; ++j) {
-    p(-1, j) = px ? p(nx - 1, j) : p(0, j);
-    p(nx, j) = px ? p(0, j) : p(nx - 1, j);
+    p(-1, j) = px ? p(nx - 1, j) : dl ? 2 * face[left] - p(0, j) : p(0, j);
+    p(nx, j) = px ? p(0, j) : dr ? 2 * face[right] - p(nx - 1, j) : p(nx - 1, j);
   }
   for (int i = -1; i <= nx; ++i) {
     p(i, -1) = py ? p(i, ny - 1) : p(i, 0);

@@ -2,6 +2,15 @@
 // inflow profile with its ramp, convective outflow with global flux correction) and ghost values
 // of the tangential velocity (no-slip by quadratic extrapolation, which is exact for a parabolic
 // profile; free slip by reflection; periodic copies).
+//
+// A pressure side (left or right) gives the pressure p_b(t) on the boundary face instead of the
+// normal velocity. Its u faces are unknowns of the step: the predictor steps them with the
+// momentum equation, the explicit terms taken from the first interior face (zero normal gradient:
+// the flow crosses the side developed) and the pressure gradient (p_0 - p_b) / (w_0 / 2) to the
+// face's value; the projection corrects them with phi_b = p_b(t^{n+1}) - p_b(t^n) on the face
+// (Dirichlet: the cell-centred ghost is 2 phi_b - phi_0). The tangential velocity has zero normal
+// gradient there (ghost = first interior value). The Poisson problem is then regular (the face
+// fixes the pressure level) and compatible whatever flux crosses the side.
 #pragma once
 
 #include <array>
@@ -28,6 +37,11 @@ class Boundaries {
   const SideBc& side(int s) const { return m_bc[s]; }
   const GhostRule& rule(int s) const { return m_rule[s]; }
   bool has_outflow() const { return m_has_outflow; }
+  bool is_pressure(int s) const { return m_bc[s].type == BcType::pressure; }
+  // The pressure on side s's boundary face at time t (pressure sides; 0 elsewhere).
+  double pressure(int s, double t) const {
+    return is_pressure(s) ? m_bc[s].boundary_pressure(t) : 0.0;
+  }
 
   // Inflow velocity into the domain at tangential coordinate s, time t.
   double inflow(int side, double s, double t) const;
@@ -38,8 +52,9 @@ class Boundaries {
   void advance_normal(Field& u, Field& v, double t, double dt);
   // Tangential ghosts (rules; outflow ghosts keep their convected value) and periodic copies.
   void fill_ghosts(Field& u, Field& v) const;
-  // Periodic copies and zero-gradient ghosts of a cell-centred field (pressure).
-  void fill_scalar(Field& p) const;
+  // Periodic copies and ghosts of a cell-centred field: zero gradient, and on a pressure side
+  // the value `face[s]` on the boundary face (ghost = 2 face[s] - first interior value).
+  void fill_scalar(Field& p, const std::array<double, 4>& face = {}) const;
   // Net volume flux into the domain through its boundary (per unit depth).
   double net_inflow(const Field& u, const Field& v) const;
   // What advance_normal() carries from step to step (the outflows' last interior lines, the

@@ -20,6 +20,7 @@ const char* type_name(BcType t) {
     case BcType::slip: return "slip";
     case BcType::inflow: return "inflow";
     case BcType::outflow: return "outflow";
+    case BcType::pressure: return "pressure";
   }
   return "?";
 }
@@ -76,16 +77,40 @@ void validate(const Config& c, double dt) {
   }
   for (int s = 0; s < 4; ++s) {
     const SideBc& b = c.bc[s];
-    if (b.type == BcType::inflow && b.ramp != Ramp::none && !(b.ramp_time > 0)) {
+    if ((b.type == BcType::inflow || b.type == BcType::pressure) && b.ramp != Ramp::none &&
+        !(b.ramp_time > 0)) {
       bad(c, fmt::format("fluid.boundary.{}.ramp_time must be > 0 with a ramp, got {}", kSideNames[s],
                          b.ramp_time));
+    }
+  }
+  // A pressure side: its u faces are stepped by the momentum equation and corrected by the
+  // projection with the pressure given on the face (boundary.hpp). Only on the x sides, with the
+  // explicit predictor, and not beside a convective outflow, whose flux is fixed by convection
+  // alone (the flow through the pressure side could then never start).
+  for (int s = 0; s < 4; ++s) {
+    if (c.bc[s].type != BcType::pressure) continue;
+    if (s == bottom || s == top)
+      bad(c, fmt::format("fluid.boundary.{} = pressure: a pressure boundary is available on the left "
+                         "and right sides only", kSideNames[s]));
+    if (c.implicit)
+      bad(c, fmt::format("fluid.boundary.{} = pressure needs fluid.diffusion = \"explicit\" (the "
+                         "Crank-Nicolson predictor takes the boundary faces as given)", kSideNames[s]));
+    for (int o = 0; o < 4; ++o) {
+      if (c.bc[o].type == BcType::outflow)
+        bad(c, fmt::format("fluid.boundary.{} = pressure with fluid.boundary.{} = outflow: a convective "
+                           "outflow fixes the flux through it by convection alone, so no flow "
+                           "through the pressure side could start; make the outlet a pressure "
+                           "boundary too (type = \"pressure\", value = 0)",
+                           kSideNames[s], kSideNames[o]));
     }
   }
   const bool px = c.bc[left].type == BcType::periodic, py = c.bc[bottom].type == BcType::periodic;
   const bool x_stretched = c.x.sponge_cells > 0 && c.x.sponge_ratio != 1.0;
   const bool y_stretched = c.y.tanh_beta > 0;
-  if (c.x.sponge_cells > 0 && c.bc[right].type != BcType::outflow) {
-    bad(c, fmt::format("fluid.sponge needs an outflow on the right side, got fluid.boundary.right = {}",
+  if (c.x.sponge_cells > 0 && c.bc[right].type != BcType::outflow &&
+      c.bc[right].type != BcType::pressure) {
+    bad(c, fmt::format("fluid.sponge needs an outflow or a pressure boundary on the right side, got "
+                       "fluid.boundary.right = {}",
                        type_name(c.bc[right].type)));
   }
   if (y_stretched && py) {
@@ -158,7 +183,8 @@ namespace {
 
 SideBc read_side(const fsi::SceneTable& t) {
   SideBc b;
-  const std::string type = t.choice("type", {"periodic", "wall", "slip", "inflow", "outflow"});
+  const std::string type =
+      t.choice("type", {"periodic", "wall", "slip", "inflow", "outflow", "pressure"});
   if (type == "periodic") b.type = BcType::periodic;
   if (type == "wall") {
     b.type = BcType::wall;
@@ -174,9 +200,18 @@ SideBc read_side(const fsi::SceneTable& t) {
                     ? Profile::uniform
                     : Profile::parabolic;
     b.mean = t.number("mean");
+  }
+  if (type == "inflow" || type == "pressure") {
     const std::string ramp = t.choice("ramp", {"none", "cosine", "linear"}, "none");
     b.ramp = ramp == "cosine" ? Ramp::cosine : ramp == "linear" ? Ramp::linear : Ramp::none;
     b.ramp_time = b.ramp == Ramp::none ? 0.0 : t.positive("ramp_time");
+  }
+  if (type == "pressure") {
+    b.type = BcType::pressure;
+    b.value = t.number("value", 0.0);
+    b.amplitude = t.number("amplitude", 0.0);
+    b.omega = t.number("omega", 0.0);
+    b.phase_angle = t.number("phase", 0.0);
   }
   if (type == "outflow") {
     b.type = BcType::outflow;

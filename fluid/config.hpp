@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <numbers>
 
 #include <array>
 #include <string>
@@ -19,7 +20,7 @@ namespace fluid {
 enum Side : int { left = 0, right = 1, bottom = 2, top = 3 };
 inline constexpr const char* kSideNames[4] = {"left", "right", "bottom", "top"};
 
-enum class BcType { periodic, wall, slip, inflow, outflow };
+enum class BcType { periodic, wall, slip, inflow, outflow, pressure };
 enum class Profile { uniform, parabolic };
 enum class Ramp { none, cosine, linear };
 enum class Phase { bulk, orlanski };
@@ -28,13 +29,23 @@ struct SideBc {
   BcType type = BcType::wall;
   double velocity = 0;  // wall: tangential speed along +x (bottom/top) or +y (left/right) ...
   double amplitude = 0;  // ... plus amplitude sin(omega t + phase_angle): an oscillating wall
-  double omega = 0;
+  double omega = 0;      //     (pressure: the same oscillation added to the pressure)
   double phase_angle = 0;
   double wall_speed(double t) const { return velocity + amplitude * std::sin(omega * t + phase_angle); }
   Profile profile = Profile::parabolic;  // inflow: profile shape ...
   double mean = 0;                       // ... mean speed into the domain ...
-  Ramp ramp = Ramp::none;                // ... and its start-up in time:
+  Ramp ramp = Ramp::none;                // ... and its start-up in time (inflow, pressure):
   double ramp_time = 0;  // cosine: (1 - cos(pi t / T)) / 2 for t < T (Turek-Hron Eq. 26)
+  double ramp_factor(double t) const {
+    if (ramp == Ramp::cosine && t < ramp_time) return 0.5 * (1 - std::cos(std::numbers::pi * t / ramp_time));
+    if (ramp == Ramp::linear && t < ramp_time) return t / ramp_time;
+    return 1.0;
+  }
+  // pressure: p_b(t) = ramp(t) value + amplitude sin(omega t + phase_angle) on the boundary face
+  double value = 0;
+  double boundary_pressure(double t) const {
+    return ramp_factor(t) * value + amplitude * std::sin(omega * t + phase_angle);
+  }
   Phase phase = Phase::bulk;  // outflow: convection speed, the bulk outlet velocity or Orlanski's
 };
 

@@ -34,6 +34,12 @@ void Solver::predictor(double dt, double t_half) {
     for (int i = m_i0; i < nx; ++i) {
       u[i] += dt * (c1 * h[i] + c0 * ho[i] + acc[0] - ri * (p[i] - p[i - 1]) * xdi[i]);
     }
+    // A pressure side's boundary face: the explicit terms of its interior neighbour, the
+    // gradient to the face pressure p_b(t^n) (the ghost p_{-1} = 2 p_b - p_0: xdi = 1 / w_0).
+    if (m_iu0 == 0 && m_i0 == 1)
+      u[0] += dt * (c1 * h[1] + c0 * ho[1] + acc[0] - ri * (p[0] - p[-1]) * xdi[0]);
+    if (m_iu1 == nx + 1)
+      u[nx] += dt * (c1 * h[nx - 1] + c0 * ho[nx - 1] + acc[0] - ri * (p[nx] - p[nx - 1]) * xdi[nx]);
   }
   for (int j = m_j0; j < ny; ++j) {
     double* v = m_v.row(j);

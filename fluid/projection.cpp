@@ -5,10 +5,13 @@
 
 namespace fluid {
 
-// Projection: L phi = (rho / dt) D u~ (Neumann at non-periodic sides), then
+// Projection: L phi = (rho / dt) D u~ (Neumann at walls, inflows and outflows; on a pressure
+// side phi = phi_b = p_b(t^{n+1}) - p_b(t^n) on the face), then
 //   u^{n+1} = u~ - (dt / rho) G phi,   p^{n+1} = p^n + phi.
-// D G is exactly the operator the fast solver inverts, so D u^{n+1} = 0 to round-off.
-void Solver::project(double dt) {
+// D G is exactly the operator the fast solver inverts, so D u^{n+1} = 0 to round-off. On a
+// pressure side the first cell's row reads [(phi_1 - phi_0) d_1 - 2 (phi_0 - phi_b) / w_0] / w_0:
+// the solver's operator holds the phi_0 part, -2 phi_b / w_0^2 moves to the right-hand side.
+void Solver::project(double dt, double t_new) {
   const int nx = m_grid.nx(), ny = m_grid.ny();
   const double *xwi = m_grid.x().wi(), *ywi = m_grid.y().wi();
   const double *xdi = m_grid.x().di(), *ydi = m_grid.y().di();
@@ -35,6 +38,15 @@ void Solver::project(double dt) {
       }
     }
   }
+  const std::array<double, 4> p_new = boundary_pressure(t_new), p_old = boundary_pressure(m_t);
+  std::array<double, 4> phi_b{};
+  for (int s : {int(left), int(right)}) {
+    if (!m_bnd.is_pressure(s)) continue;
+    phi_b[s] = p_new[s] - p_old[s];
+    const int i = s == left ? 0 : nx - 1;
+    const double coef = 2.0 * xwi[i] * xwi[i];
+    for (int j = 0; j < ny; ++j) buf[buf_index(i, j, 0, 0, nt)] -= coef * phi_b[s];
+  }
   {
     const PhaseTimer t(m_time.poisson);
     ps.solve();
@@ -48,13 +60,13 @@ void Solver::project(double dt) {
       p[i] += phi[i];
     }
   }
-  m_bnd.fill_scalar(m_phi);
-  m_bnd.fill_scalar(m_p);
+  m_bnd.fill_scalar(m_phi, phi_b);
+  m_bnd.fill_scalar(m_p, p_new);
   const double c = dt / m_cfg.density;
   for (int j = 0; j < ny; ++j) {
     double* u = m_u.row(j);
     const double* phi = m_phi.row(j);
-    for (int i = m_i0; i < nx; ++i) u[i] -= c * (phi[i] - phi[i - 1]) * xdi[i];
+    for (int i = m_iu0; i < m_iu1; ++i) u[i] -= c * (phi[i] - phi[i - 1]) * xdi[i];
   }
   for (int j = m_j0; j < ny; ++j) {
     double* v = m_v.row(j);
@@ -68,8 +80,9 @@ void Solver::project(double dt) {
 void Solver::project_initial() {
   m_bnd.advance_normal(m_u, m_v, m_t, 0.0);
   const Field p = m_p;
-  project(1.0);
+  project(1.0, m_t);
   m_p = p;
+  m_bnd.fill_scalar(m_p, boundary_pressure(m_t));
   m_bnd.fill_ghosts(m_u, m_v);
 }
 

@@ -59,14 +59,18 @@ Operator1D make_operator(const Axis& ax, Loc loc, bool transform, const Boundari
     op.b[k] = -(op.a[k] + op.c[k]);
   }
   if (loc == Loc::pressure) {
-    op.lo = op.hi = Closure::neumann_half;
-    op.b[0] = -op.c[0];
-    op.b[n - 1] = -op.a[n - 1];
-    op.singular = true;
+    // Zero normal gradient, or on a pressure side the value on the face: the ghost is
+    // 2 phi_b - phi_0, its phi_b part on the right-hand side (Solver::project).
+    const bool dlo = b.is_pressure(side_lo), dhi = b.is_pressure(side_lo + 1);
+    op.lo = dlo ? Closure::dirichlet_half : Closure::neumann_half;
+    op.hi = dhi ? Closure::dirichlet_half : Closure::neumann_half;
+    op.b[0] = dlo ? -(op.c[0] + 2 * op.a[0]) : -op.c[0];
+    op.b[n - 1] = dhi ? -(op.a[n - 1] + 2 * op.c[n - 1]) : -op.a[n - 1];
+    op.singular = !dlo && !dhi;
   } else {
     for (int e = 0; e < 2; ++e) {
       const int side = side_lo + e;
-      const bool slip = b.side(side).type == BcType::slip;
+      const bool slip = b.side(side).type == BcType::slip || b.is_pressure(side);
       (e == 0 ? op.lo : op.hi) = slip ? Closure::neumann_half : Closure::dirichlet_half;
       // Fold the ghost rule g = ga q0 + gb q1 (+ data, on the right-hand side) into the row.
       const GhostRule& r = b.rule(side);
@@ -108,6 +112,8 @@ Solver::Solver(const Config& c, double dt)
   m_t_axis = m_grid.x().uniform() ? 0 : 1;
   m_i0 = m_grid.x().periodic() ? 0 : 1;
   m_j0 = m_grid.y().periodic() ? 0 : 1;
+  m_iu0 = m_bnd.is_pressure(left) ? 0 : m_i0;
+  m_iu1 = m_bnd.is_pressure(right) ? nx + 1 : nx;
   m_u = Field(nx + 1, ny);
   m_v = Field(nx, ny + 1);
   m_p = Field(nx, ny);
@@ -130,9 +136,14 @@ Solver::Solver(const Config& c, double dt)
     build_implicit(dt);
   }
   m_bnd.fill_ghosts(m_u, m_v);
+  m_bnd.fill_scalar(m_p, boundary_pressure(m_t));
 }
 
 Solver::~Solver() = default;
+
+std::array<double, 4> Solver::boundary_pressure(double t) const {
+  return {m_bnd.pressure(0, t), m_bnd.pressure(1, t), m_bnd.pressure(2, t), m_bnd.pressure(3, t)};
+}
 
 // Helmholtz operators of Crank-Nicolson: (L - 2/(nu dt)) for u and for v.
 void Solver::build_implicit(double dt) {
@@ -253,7 +264,7 @@ void Solver::correct(double dt, const CouplingIn& in, CouplingOut& out) {
     const PhaseTimer t(m_time.predictor);
     immersed_forcing(dt, in, out);
   }
-  project(dt);
+  project(dt, m_t + dt);
   {
     const PhaseTimer t(m_time.boundaries);
     m_bnd.fill_ghosts(m_u, m_v);

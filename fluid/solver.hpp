@@ -129,7 +129,9 @@ class Solver {
   void add_fiber_force(double dt, const CouplingIn& fibers);                 // predictor.cpp
   void solve_implicit();                                                     // predictor.cpp
   void immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out);  // forcing.cpp
-  void project(double dt);                                                   // projection.cpp
+  // dt, and the time whose boundary pressures p^(n+1) takes (t^n + dt; t^n for project_initial).
+  void project(double dt, double t_new);                                    // projection.cpp
+  std::array<double, 4> boundary_pressure(double t) const;                  // solver.cpp
   void keep_predictor();                                                     // solver.cpp
   void restore_predictor();                                                  // solver.cpp
   void correct(double dt, const CouplingIn& in, CouplingOut& out);           // solver.cpp
@@ -149,6 +151,9 @@ class Solver {
   SpongeWeights m_sponge;
   int m_t_axis = 0;
   int m_i0 = 0, m_j0 = 0;
+  // u faces the predictor and the projection step: [m_iu0, m_iu1) (the interior, and the
+  // boundary faces of pressure sides).
+  int m_iu0 = 0, m_iu1 = 0;
   double m_t = 0, m_dt_prev = 0, m_dt_implicit = 0;
   long m_step = 0;
   double m_nu = 0;

@@ -99,3 +99,23 @@ TEST_CASE("unknown keys are errors", "[fluid][config]") {
                     Contains("viscocity"));
 }
 
+
+TEST_CASE("pressure boundaries: where they are allowed", "[fluid][config][pressure]") {
+  std::string open = replace(kGood, "left = { type = \"periodic\" }",
+                             "left = { type = \"pressure\", value = 2.0, ramp = \"cosine\", ramp_time = 0.5 }");
+  open = replace(open, "right = { type = \"periodic\" }", "right = { type = \"pressure\" }");
+  const fluid::Config c = read(open);
+  CHECK(c.bc[fluid::left].type == fluid::BcType::pressure);
+  CHECK(c.bc[fluid::left].boundary_pressure(0.25) == Approx(1.0));
+  CHECK(c.bc[fluid::right].boundary_pressure(3.0) == 0.0);
+  // With a sponge on the right: allowed.
+  CHECK_NOTHROW(read(open + "[fluid.sponge]\ncells = 4\nratio = 1.1\n"));
+  CHECK_THROWS_WITH(read(replace(open, "right = { type = \"pressure\" }", "right = { type = \"outflow\" }")),
+                    Contains("fluid.boundary.left = pressure with fluid.boundary.right = outflow") &&
+                        Contains("fluid_config_test.toml"));
+  CHECK_THROWS_WITH(read(replace(open, "bottom = { type = \"wall\" }", "bottom = { type = \"pressure\" }")),
+                    Contains("fluid.boundary.bottom = pressure") && Contains("left and right sides only"));
+  CHECK_THROWS_WITH(read(replace(open, "viscosity = 0.01", "viscosity = 0.01\ndiffusion = \"implicit\"")),
+                    Contains("fluid.boundary.left = pressure needs fluid.diffusion = \"explicit\""));
+  CHECK_THROWS_WITH(read(replace(open, "value = 2.0", "value = \"high\"")), Contains("value"));
+}
