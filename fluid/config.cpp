@@ -229,6 +229,8 @@ Config read_config(const fsi::SceneTable& f, double dt) {
   c.density = f.positive("density");
   c.viscosity = f.positive("viscosity");
   c.implicit = f.choice("diffusion", {"explicit", "implicit"}, "explicit") == "implicit";
+  // Only when given: a scene without it keeps its effective scene as it was.
+  if (f.has("upwind_blend")) c.upwind_blend = f.in_range("upwind_blend", 0.0, 1.0, false, 0.0);
 
   const fsi::SceneTable g = f.table("grid");
   const std::vector<double> cells = g.numbers("cells");

@@ -69,6 +69,8 @@ struct Config {
   AxisSpec x, y;
   std::array<SideBc, 4> bc;  // left, right, bottom, top
   bool implicit = false;     // Crank-Nicolson diffusion (else explicit AB2)
+  // Weight of first-order upwind in the convective fluxes outside the sponge (0: central).
+  double upwind_blend = 0;
   // Body force per unit volume f(t) = body + oscillating sin(2 pi t / period + phase) (Eq. 29
   // with body = 0), plus rho g.
   std::array<double, 2> body{0, 0}, oscillating{0, 0}, gravity{0, 0};

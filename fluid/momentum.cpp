@@ -4,14 +4,14 @@
 
 namespace fluid {
 
-SpongeWeights sponge_weights(const Grid& g) {
+SpongeWeights sponge_weights(const Grid& g, double blend) {
   SpongeWeights s;
   const int nx = g.nx(), start = g.x().sponge_start();
-  s.active = start < nx;
+  s.active = start < nx || blend > 0;
   s.centre.assign(nx + 2, 0);
   s.face.assign(nx + 3, 0);
-  for (int i = -1; i <= nx; ++i) s.centre[i + 1] = i >= start ? 1.0 : 0.0;
-  for (int i = -1; i <= nx + 1; ++i) s.face[i + 1] = i >= start ? 1.0 : 0.0;
+  for (int i = -1; i <= nx; ++i) s.centre[i + 1] = i >= start ? 1.0 : blend;
+  for (int i = -1; i <= nx + 1; ++i) s.face[i + 1] = i >= start ? 1.0 : blend;
   return s;
 }
 

@@ -9,13 +9,14 @@
 
 namespace fluid {
 
-// Upwind weights per x position: beta = 1 inside the sponge (upwind), 0 elsewhere (central).
+// Upwind weights per x position: beta = 1 inside the sponge (upwind), `blend` elsewhere (0:
+// central; 0 < blend <= 1: the carried value moves that far from the average to the upwind one).
 struct SpongeWeights {
   std::vector<double> centre;  // cell i, offset 1: index i + 1, i in [-1, nx]
   std::vector<double> face;    // face i, offset 1, i in [-1, nx + 1]
   bool active = false;
 };
-SpongeWeights sponge_weights(const Grid& g);
+SpongeWeights sponge_weights(const Grid& g, double blend = 0.0);
 
 // Over the active u faces i in [i0, nx), j in [0, ny), and v faces i in [0, nx), j in [j0, ny):
 //   hu = -d(uu)/dx - d(vu)/dy + nu_e lap(u),   hv = -d(uv)/dx - d(vv)/dy + nu_e lap(v)

@@ -105,7 +105,7 @@ Solver::Solver(const Config& c, double dt)
             return y;
           }()),
       m_bnd(m_grid, c.bc),
-      m_sponge(sponge_weights(m_grid)) {
+      m_sponge(sponge_weights(m_grid, c.upwind_blend)) {
   validate(c, dt);
   m_nu = c.viscosity / c.density;
   const int nx = m_grid.nx(), ny = m_grid.ny();

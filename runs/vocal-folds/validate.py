@@ -30,6 +30,11 @@ P.add_argument("--run", type=float, metavar="H", help="one coupled run at cleara
 P.add_argument("--grid", choices=("paper", "coarse"), default="paper", help="grid of --run")
 P.add_argument("--t-end", type=cli.positive, default=10.0, help="end time of --run")
 P.add_argument("--impulsive", action="store_true", help="--run without the inflow ramp")
+P.add_argument("--upwind", type=float, metavar="B", default=None,
+               help="--run with fluid.upwind_blend = B (first-order upwind weight outside the sponge)")
+P.add_argument("--p-sub", type=float, metavar="P", default=None,
+               help="--run with a pressure inlet: subglottal pressure P (ramped like the inflow), "
+                    "pressure 0 at the outlet, instead of the velocity inflow")
 ARGS = P.parse_args()
 if not (ARGS.modes or ARGS.short or ARGS.run is not None):
     ARGS.modes = ARGS.short = True
@@ -39,7 +44,8 @@ GEO = os.path.join(HERE, "fold.geo")
 PAPER_MODES = (1.85, 4.12, 5.45)
 
 
-def scene(h, grid="paper", t_end=10.0, interval=0.05, ramp=None, fluid=True, modes=0):
+def scene(h, grid="paper", t_end=10.0, interval=0.05, ramp=None, fluid=True, modes=0, p_sub=None,
+          upwind=None):
     """scene.toml at clearance h: the grid 100 (1 + h) across (coarse: 25 (1 + h), 140 + 10
     sponge cells along); without fluid, the solid alone (for the modes)."""
     text = open(os.path.join(HERE, "scene.toml")).read()
@@ -51,6 +57,16 @@ def scene(h, grid="paper", t_end=10.0, interval=0.05, ramp=None, fluid=True, mod
     text = text.replace("size = [5.6, 1.02]", f"size = [5.6, {1 + h!r}]")
     text = text.replace("cells = 40\n", f"cells = {sponge}\n").replace("ratio = 1.05", f"ratio = {ratio}")
     text = text.replace("t_end = 10.0", f"t_end = {t_end!r}").replace("interval = 0.05", f"interval = {interval!r}")
+    if p_sub is not None:
+        # The physical alternative at a closed glottis: the subglottal pressure is given, the
+        # flux is what passes; the outlet a pressure boundary at 0 (a convective outflow fixes
+        # its flux by convection alone), the sponge before it as before.
+        text = text.replace('left = { type = "inflow", profile = "parabolic", mean = 1.0,',
+                            f'left = {{ type = "pressure", value = {p_sub!r},')
+        text = text.replace('right = { type = "outflow", phase = "orlanski" }',
+                            'right = { type = "pressure", value = 0.0 }')
+    if upwind is not None:
+        text = text.replace("viscosity = 6.666666666666667e-4", f"viscosity = 6.666666666666667e-4\nupwind_blend = {upwind!r}")
     if ramp == "none":
         text = text.replace('ramp = "cosine", ramp_time = 0.5', 'ramp = "none"')
     if not fluid:
@@ -122,8 +138,10 @@ if ARGS.modes:
     fig.savefig(os.path.join(OUT, "modes.png"), dpi=120)
 
 
-def coupled(name, h, grid, t_end, ramp=None, check=False):
-    r = job.run(name, scene(h, grid=grid, t_end=t_end, interval=0.02, ramp=ramp), check=check)
+def coupled(name, h, grid, t_end, ramp=None, check=False, p_sub=None, upwind=None):
+    r = job.run(name, scene(h, grid=grid, t_end=t_end, interval=0.02, ramp=ramp, p_sub=p_sub,
+                            upwind=upwind),
+                check=check)
     err = job.first_error(r.log)
     hist = solidout.history(r.folder) if os.path.exists(os.path.join(r.folder, "solid_history.csv")) else None
     return r, err, hist
@@ -157,8 +175,11 @@ if ARGS.short:
                           "episode_ends": [float(t[i]) for i in ends]}
 
 if ARGS.run is not None:
-    r, err, hist = coupled(f"run_h{ARGS.run:g}_{ARGS.grid}", ARGS.run, ARGS.grid, ARGS.t_end,
-                           ramp="none" if ARGS.impulsive else None)
+    inlet = "" if ARGS.p_sub is None else f"_p{ARGS.p_sub:g}"
+    inlet += "" if ARGS.upwind is None else f"_b{ARGS.upwind:g}"
+    r, err, hist = coupled(f"run_h{ARGS.run:g}_{ARGS.grid}{inlet}", ARGS.run, ARGS.grid, ARGS.t_end,
+                           ramp="none" if ARGS.impulsive else None, p_sub=ARGS.p_sub,
+                           upwind=ARGS.upwind)
     print(f"run h = {ARGS.run}: exit {r.returncode}, {err or 'ran to the end'}, wall {r.wall:.0f} s")
     metrics[f"run_h{ARGS.run:g}_runs_to_the_end"] = holds(r.returncode == 0 and not err)
     extra["run_error"] = err
