@@ -31,7 +31,8 @@ usage: ./fsi COMMAND [ARGS]
   test --sanitize [ARGS]      the same in an address + undefined-behaviour sanitizer build
                               (build-sanitize/); unit and integration tests
   validate [CASE...]          run the validation cases in runs/ (all when none is named)
-  bench [WHAT]                run a benchmark (fluid, solid, fiber, coupler, coupled, protocol);
+  bench [WHAT]                run a benchmark (fluid, solid, fiber, coupler, coupled, protocol,
+                              vocal-folds);
                               without WHAT, list them
   build                       install missing packages, configure and build (incremental)
   deps                        install missing Debian packages (as root) or list them
@@ -283,7 +284,7 @@ validate() {
 bench() {
   build
   local what=${1:-}
-  local available=(protocol coupled)
+  local available=(protocol coupled vocal-folds)
   for b in "$BIN"/bench_*; do [ -x "$b" ] && available+=("${b##*/bench_}"); done
   if [ -z "$what" ]; then
     say "benchmarks: ${available[*]}"
@@ -294,6 +295,8 @@ bench() {
     bench_protocol
   elif [ "$what" = coupled ]; then
     bench_coupled
+  elif [ "$what" = vocal-folds ]; then
+    bench_vocal_folds
   elif [ -x "$BIN/bench_$what" ]; then
     "$BIN/bench_$what" --out "$ROOT/out/bench/$what.json"
   else
@@ -401,6 +404,18 @@ print("  waiting by yields only, no sleeps (common/runtime.cpp) | -0.3 ms messag
 print("  work ahead on a thread of its own at nice 19 (so a waking coupler gets a core at once) |"
       " -1 ms messages | worse: 18.2-22.7 ms (messages 2.1-3.3: the fluid's predictor starved beside"
       " the clipping, with one footprint thread too): not kept")
+PY
+}
+
+# A coupled step of the vocal folds on the paper's grid (runs/bench-vocal-folds): where it goes.
+bench_vocal_folds() {
+  local scene=$ROOT/runs/bench-vocal-folds/scene.toml dir=$ROOT/out/bench/vocal-folds
+  compose "$scene" --out-dir "$dir" --overwrite
+  "${CMD[@]}"
+  /usr/bin/python3 "$ROOT/runs/bench-vocal-folds/report.py" "$dir/summary.json" \
+    "$ROOT/out/bench/vocal-folds.json"
+  /usr/bin/python3 - <<'PY'
+print("notes: change | predicted | measured")
 PY
 }
 

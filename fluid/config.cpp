@@ -181,6 +181,13 @@ void validate(const Config& c, double dt) {
 
 namespace {
 
+// The optional oscillation amplitude sin(omega t + phase) of a wall's speed or a face pressure.
+void read_oscillation(const fsi::SceneTable& t, SideBc& b) {
+  b.amplitude = t.number("amplitude", 0.0);
+  b.omega = t.number("omega", 0.0);
+  b.phase_angle = t.number("phase", 0.0);
+}
+
 SideBc read_side(const fsi::SceneTable& t) {
   SideBc b;
   const std::string type =
@@ -189,9 +196,7 @@ SideBc read_side(const fsi::SceneTable& t) {
   if (type == "wall") {
     b.type = BcType::wall;
     b.velocity = t.number("velocity", 0.0);
-    b.amplitude = t.number("amplitude", 0.0);
-    b.omega = t.number("omega", 0.0);
-    b.phase_angle = t.number("phase", 0.0);
+    read_oscillation(t, b);
   }
   if (type == "slip") b.type = BcType::slip;
   if (type == "inflow") {
@@ -209,9 +214,7 @@ SideBc read_side(const fsi::SceneTable& t) {
   if (type == "pressure") {
     b.type = BcType::pressure;
     b.value = t.number("value", 0.0);
-    b.amplitude = t.number("amplitude", 0.0);
-    b.omega = t.number("omega", 0.0);
-    b.phase_angle = t.number("phase", 0.0);
+    read_oscillation(t, b);
   }
   if (type == "outflow") {
     b.type = BcType::outflow;
