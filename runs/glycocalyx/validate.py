@@ -16,6 +16,22 @@ wall lowers it further, fibers raise the pressure fluctuation at C, fibers lower
 fluctuation, the wall moves in phase with the pulsation. --sweep adds the elastic wall with
 fibers at other Young's moduli (the flow-rate amplitude against E, the paper's Fig. 23).
 
+Outputs in OUT (FSI_OUT, else out/glycocalyx): the runs in runs/<variant>/, summary.json (the
+metrics; the numbers behind the figures under profiles, fields, flow_rate_vs_E) and the figures
+(figures.py draws all but the first):
+- glycocalyx.png: p and tau at C, the flow rate, u at D and the wall's velocity at C over the
+  last periods (the paper's Figs. 19, 20, 22);
+- profiles.png: u(y) along x = 1/2 from the wall's surface at C to y = 3H/4, the variants on one
+  axes, at the output time of the last period where the driving |sin(2 pi t / T)| is smallest
+  (t = kT/2; of equal ones the latest; Fig. 21);
+- fields_<variant>.png, for the variants with fibers: the pressure with velocity vectors, the
+  fibers and the wall at the output times of the last period with the largest forward and the
+  largest backward flow rate (Figs. 17-18);
+- flow_rate_vs_E.png, with --sweep: the flow-rate amplitude against E, with the default E's
+  elastic wall with fibers and the rigid wall with fibers (E -> infinity) when they ran (Fig. 23).
+"The last period" of a figure is that of the output steps written (every 0.1), so a short test
+run draws its last steps.
+
 --short (./fsi test): the elastic wall with fibers for 400 steps; judged: the run holds (the
 fibers' root inertia on a wall whose nodes are 60 times lighter than a fiber: explicit, it
 diverges within 10 steps), and the wall at C moves slower than the fluid at D.
@@ -28,6 +44,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "lib"))
 sys.path.insert(0, HERE)
 import cli  # noqa: E402
+import figures  # noqa: E402
 import job  # noqa: E402
 import make_scene  # noqa: E402
 import numpy as np  # noqa: E402
@@ -199,6 +216,29 @@ def main():
         metrics[f"sweep_E{e:g}.flow_rate_amplitude"] = reported(sweep[e]["flow_rate_amplitude"])
         print(f"E = {e:g}: flow-rate amplitude {sweep[e]['flow_rate_amplitude']:.5g}", flush=True)
     plots(folders, t_end, last)
+    # The paper's Figs. 21, 17-18 and 23 from the run folders (figures.py): reported, not judged.
+    paths = {v: f for v, (f, _) in folders.items()}
+    drawn = {"profiles": figures.profiles(paths, os.path.join(OUT, "profiles.png"))}
+    ts = ", ".join(f"{v} {x['t']:.4g}" for v, x in drawn["profiles"].items())
+    print(f"profiles.png: u(y) through C at the smallest driving, t = ({ts})")
+    drawn["fields"] = {}
+    for v, folder in paths.items():
+        if VARIANTS[v][1]:
+            drawn["fields"][v] = figures.fields(folder, v, os.path.join(OUT, f"fields_{v}.png"))
+            print(f"fields_{v}.png: " + ", ".join(
+                f"t = {x['t']:.4g} (largest {k} flow: Q = {x['flow_rate']:.3g})"
+                for k, x in drawn["fields"][v].items()))
+    if sweep:
+        # the default E's run is the variant elastic-fibers (when it ran), E -> infinity the
+        # rigid wall with fibers
+        amplitudes = {e: x["flow_rate_amplitude"] for e, x in sweep.items()}
+        if "elastic-fibers" in r:
+            amplitudes.setdefault(make_scene.E_WALL, r["elastic-fibers"]["flow_rate_amplitude"])
+        rigid = r["rigid-fibers"]["flow_rate_amplitude"] if "rigid-fibers" in r else None
+        drawn["flow_rate_vs_E"] = figures.flow_rate_vs_e(amplitudes, rigid, make_scene.E_WALL,
+                                                         os.path.join(OUT, "flow_rate_vs_E.png"))
+        print("flow_rate_vs_E.png: " + ", ".join(f"E = {e:g}: {a:.4g}" for e, a in sorted(
+            amplitudes.items())) + ("" if rigid is None else f", rigid: {rigid:.4g}"))
     print("\n| variant | tau mean at C | tau amplitude | p amplitude at C | flow-rate amplitude | "
           "wall v at C, phase | wall s |")
     print("|---|---|---|---|---|---|---|")
@@ -208,7 +248,7 @@ def main():
         print(f"| {v} | {x['tau_mean']:.4g} | {x['tau_amplitude']:.4g} | {x['p_amplitude']:.4g} | "
               f"{x['flow_rate_amplitude']:.4g} | {wall} | {x['wall_s']:.0f} |")
     finish("glycocalyx", metrics, {"variants": r, "sweep": {str(k): v for k, v in sweep.items()},
-                                   "periods": periods, "last": last})
+                                   "periods": periods, "last": last, **drawn})
 
 
 if __name__ == "__main__":
