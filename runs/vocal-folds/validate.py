@@ -17,7 +17,7 @@ contact between them.
   t >= 1, the dominant frequency and the nearest eigenfrequency, the amplitude, contact, forces
   and impulses; spectra.png (Fig. 13), frequency.png, trajectories.png (Fig. 14), forces_h0.png
   (Fig. 15), fields.png (Fig. 12); the paper's findings reported, only "ran to t_end" judged.
-With no option: --modes and --short."""
+With no option (`./fsi validate vocal-folds`): --modes, --short and --sweep."""
 import fcntl
 import json
 import os
@@ -56,7 +56,7 @@ P.add_argument("--no-run", action="store_true",
                help="--sweep: start no run, process only the runs that are there")
 ARGS = P.parse_args()
 if not (ARGS.modes or ARGS.short or ARGS.run is not None or ARGS.sweep):
-    ARGS.modes = ARGS.short = True
+    ARGS.modes = ARGS.short = ARGS.sweep = True
 if ARGS.sweep:
     ARGS.modes = True  # the sweep compares with the fold's eigenfrequencies and mode shapes
 OUT = job.out_dir("vocal-folds")
