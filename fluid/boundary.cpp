@@ -186,13 +186,13 @@ void Boundaries::fill_ghosts(Field& u, Field& v) const {
   }
 }
 
-void Boundaries::fill_scalar(Field& p, const std::array<double, 4>& face) const {
+void Boundaries::fill_scalar(Field& p, const FacePressure& face) const {
   const int nx = m_g.nx(), ny = m_g.ny();
   const bool px = m_bc[left].type == BcType::periodic, py = m_bc[bottom].type == BcType::periodic;
-  const bool dl = is_pressure(left), dr = is_pressure(right);
+  const bool dl = is_pressure(left) && !face[0].empty(), dr = is_pressure(right) && !face[1].empty();
   for (int j = 0; j < ny; ++j) {
-    p(-1, j) = px ? p(nx - 1, j) : dl ? 2 * face[left] - p(0, j) : p(0, j);
-    p(nx, j) = px ? p(0, j) : dr ? 2 * face[right] - p(nx - 1, j) : p(nx - 1, j);
+    p(-1, j) = px ? p(nx - 1, j) : dl ? 2 * face[0][j] - p(0, j) : p(0, j);
+    p(nx, j) = px ? p(0, j) : dr ? 2 * face[1][j] - p(nx - 1, j) : p(nx - 1, j);
   }
   for (int i = -1; i <= nx; ++i) {
     p(i, -1) = py ? p(i, ny - 1) : p(i, 0);

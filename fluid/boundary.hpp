@@ -31,6 +31,10 @@ struct GhostRule {
   bool is_data = false;  // outflow: the ghost is a value of its own (convected), not a rule
 };
 
+// Per row j of the left (0) and right (1) side: the pressure on a pressure side's boundary face;
+// empty for the other sides.
+using FacePressure = std::array<std::vector<double>, 2>;
+
 class Boundaries {
  public:
   Boundaries(const Grid& g, const std::array<SideBc, 4>& bc);
@@ -38,10 +42,6 @@ class Boundaries {
   const GhostRule& rule(int s) const { return m_rule[s]; }
   bool has_outflow() const { return m_has_outflow; }
   bool is_pressure(int s) const { return m_bc[s].type == BcType::pressure; }
-  // The pressure on side s's boundary face at time t (pressure sides; 0 elsewhere).
-  double pressure(int s, double t) const {
-    return is_pressure(s) ? m_bc[s].boundary_pressure(t) : 0.0;
-  }
 
   // Inflow velocity into the domain at tangential coordinate s, time t.
   double inflow(int side, double s, double t) const;
@@ -53,8 +53,8 @@ class Boundaries {
   // Tangential ghosts (rules; outflow ghosts keep their convected value) and periodic copies.
   void fill_ghosts(Field& u, Field& v) const;
   // Periodic copies and ghosts of a cell-centred field: zero gradient, and on a pressure side
-  // the value `face[s]` on the boundary face (ghost = 2 face[s] - first interior value).
-  void fill_scalar(Field& p, const std::array<double, 4>& face = {}) const;
+  // the value face[s][j] on the boundary face (ghost = 2 face[s][j] - first interior value).
+  void fill_scalar(Field& p, const FacePressure& face = {}) const;
   // Net volume flux into the domain through its boundary (per unit depth).
   double net_inflow(const Field& u, const Field& v) const;
   // What advance_normal() carries from step to step (the outflows' last interior lines, the

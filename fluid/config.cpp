@@ -215,6 +215,7 @@ SideBc read_side(const fsi::SceneTable& t) {
     b.type = BcType::pressure;
     b.value = t.number("value", 0.0);
     read_oscillation(t, b);
+    b.total = t.choice("entering", {"static", "total"}, "static") == "total";
   }
   if (type == "outflow") {
     b.type = BcType::outflow;

@@ -41,8 +41,11 @@ struct SideBc {
     if (ramp == Ramp::linear && t < ramp_time) return t / ramp_time;
     return 1.0;
   }
-  // pressure: p_b(t) = ramp(t) value + amplitude sin(omega t + phase_angle) on the boundary face
+  // pressure: p_b(t) = ramp(t) value + amplitude sin(omega t + phase_angle) on the boundary face;
+  // with `total`, where the flow enters through the face p_b is its total pressure p + rho u^2 / 2
+  // (fluid drawn from a reservoir at rest; at an outlet, what a backflow sees)
   double value = 0;
+  bool total = false;
   double boundary_pressure(double t) const {
     return ramp_factor(t) * value + amplitude * std::sin(omega * t + phase_angle);
   }

@@ -38,14 +38,19 @@ void Solver::project(double dt, double t_new) {
       }
     }
   }
-  const std::array<double, 4> p_new = boundary_pressure(t_new), p_old = boundary_pressure(m_t);
-  std::array<double, 4> phi_b{};
+  // The face pressure of p^(n+1) (from u~ where it depends on the velocity), and of p^n as its
+  // ghost holds it: phi_b is their difference, row by row.
+  const FacePressure p_new = face_pressure(t_new);
+  FacePressure phi_b;
   for (int s : {int(left), int(right)}) {
     if (!m_bnd.is_pressure(s)) continue;
-    phi_b[s] = p_new[s] - p_old[s];
-    const int i = s == left ? 0 : nx - 1;
+    const int i = s == left ? 0 : nx - 1, g = s == left ? -1 : nx;
     const double coef = 2.0 * xwi[i] * xwi[i];
-    for (int j = 0; j < ny; ++j) buf[buf_index(i, j, 0, 0, nt)] -= coef * phi_b[s];
+    phi_b[s].resize(ny);
+    for (int j = 0; j < ny; ++j) {
+      phi_b[s][j] = p_new[s][j] - 0.5 * (m_p(g, j) + m_p(i, j));
+      buf[buf_index(i, j, 0, 0, nt)] -= coef * phi_b[s][j];
+    }
   }
   {
     const PhaseTimer t(m_time.poisson);
@@ -82,7 +87,7 @@ void Solver::project_initial() {
   const Field p = m_p;
   project(1.0, m_t);
   m_p = p;
-  m_bnd.fill_scalar(m_p, boundary_pressure(m_t));
+  m_bnd.fill_scalar(m_p, face_pressure(m_t));
   m_bnd.fill_ghosts(m_u, m_v);
 }
 

@@ -131,7 +131,7 @@ class Solver {
   void immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out);  // forcing.cpp
   // dt, and the time whose boundary pressures p^(n+1) takes (t^n + dt; t^n for project_initial).
   void project(double dt, double t_new);                                    // projection.cpp
-  std::array<double, 4> boundary_pressure(double t) const;                  // solver.cpp
+  FacePressure face_pressure(double t) const;                               // solver.cpp
   void keep_predictor();                                                     // solver.cpp
   void restore_predictor();                                                  // solver.cpp
   void correct(double dt, const CouplingIn& in, CouplingOut& out);           // solver.cpp

@@ -118,4 +118,9 @@ TEST_CASE("pressure boundaries: where they are allowed", "[fluid][config][pressu
   CHECK_THROWS_WITH(read(replace(open, "viscosity = 0.01", "viscosity = 0.01\ndiffusion = \"implicit\"")),
                     Contains("fluid.boundary.left = pressure needs fluid.diffusion = \"explicit\""));
   CHECK_THROWS_WITH(read(replace(open, "value = 2.0", "value = \"high\"")), Contains("value"));
+  CHECK(read(replace(open, "right = { type = \"pressure\" }",
+                     "right = { type = \"pressure\", entering = \"total\" }")).bc[fluid::right].total);
+  CHECK_THROWS_WITH(read(replace(open, "right = { type = \"pressure\" }",
+                                 "right = { type = \"pressure\", entering = \"dynamic\" }")),
+                    Contains("entering"));
 }

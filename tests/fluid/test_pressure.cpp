@@ -142,3 +142,31 @@ TEST_CASE("an oscillating inlet pressure gives Womersley's flow", "[fluid][press
   INFO("max error over the sixth period " << err << " of the centreline amplitude " << amp);
   CHECK(err < 5e-3 * amp);
 }
+
+TEST_CASE("a total-pressure face: Bernoulli's speed between free-slip walls", "[fluid][pressure]") {
+  // Free-slip walls, no shear: the flow from a face whose entering fluid has total pressure P to
+  // a face at static pressure 0 settles to the plug u = sqrt(2 P / rho), the static pressure 0
+  // everywhere (P - rho u^2 / 2 on the entering face). Both directions: entering on the left, and
+  // on the right (a backflow into an outlet).
+  for (int side : {int(left), int(right)}) {
+    const double P = 2.0, rho = 1.5;
+    Config c = pressure_channel(16, 8, 1.0, 0.0);
+    c.density = rho;
+    c.viscosity = 0.05;
+    c.bc[bottom].type = c.bc[top].type = BcType::slip;
+    c.bc[side].value = P;
+    c.bc[side].total = true;
+    const double dt = 0.2 * explicit_diffusion_limit(c);
+    Solver s(c, dt);
+    set_initial(s);
+    for (long k = 0; k < std::lround(20.0 / dt); ++k) s.step(dt);
+    const double expect = (side == left ? 1.0 : -1.0) * std::sqrt(2 * P / rho);
+    const double err = max_u_error(s, [&](double) { return expect; });
+    double pmax = 0;
+    for (int j = 0; j < s.grid().ny(); ++j)
+      for (int i = 0; i < s.grid().nx(); ++i) pmax = std::max(pmax, std::abs(s.p()(i, j)));
+    INFO("entering on side " << side << ": max |u - " << expect << "| = " << err << ", max |p| = " << pmax);
+    CHECK(err < 1e-8);
+    CHECK(pmax < 1e-8);
+  }
+}
