@@ -4,16 +4,17 @@
 namespace fluid {
 
 // Immersed solid (paper Eq. 21): f_s = rho_f alpha (u_s - u~) / dt, then u~ += dt f_s / rho_f,
-// i.e. u~ <- (1 - alpha) u~ + alpha u_s, on the solid's faces.
+// i.e. u~ <- (1 - alpha) u~ + alpha u_s, on the solid's faces (the u faces the step solves for:
+// the interior and a pressure side's boundary faces).
 void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out) {
   const double rho = m_cfg.density;
-  const int nx = m_grid.nx(), ny = m_grid.ny();
+  const int ny = m_grid.ny();
   out.solid_u_force.resize(in.solid_u_index.size());
   out.solid_v_force.resize(in.solid_v_index.size());
   for (std::size_t q = 0; q < in.solid_u_index.size(); ++q) {
     const auto [i, j] = face_of(0, in.solid_u_index[q]);
     double f = 0;
-    if (i >= m_i0 && i < nx) {
+    if (i >= m_iu0 && i < m_iu1) {
       double& u = m_u(i, j);
       f = rho * in.solid_u_alpha[q] * (in.solid_u_velocity[q] - u) / dt;
       u += dt * f / rho;

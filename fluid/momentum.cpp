@@ -7,11 +7,13 @@ namespace fluid {
 SpongeWeights sponge_weights(const Grid& g, double blend) {
   SpongeWeights s;
   const int nx = g.nx(), start = g.x().sponge_start();
-  s.active = start < nx || blend > 0;
+  const bool sponge = start < nx;
+  s.active = sponge || blend > 0;
   s.centre.assign(nx + 2, 0);
   s.face.assign(nx + 3, 0);
-  for (int i = -1; i <= nx; ++i) s.centre[i + 1] = i >= start ? 1.0 : blend;
-  for (int i = -1; i <= nx + 1; ++i) s.face[i + 1] = i >= start ? 1.0 : blend;
+  // Without a sponge the ghost column and the last face take the blend too.
+  for (int i = -1; i <= nx; ++i) s.centre[i + 1] = sponge && i >= start ? 1.0 : blend;
+  for (int i = -1; i <= nx + 1; ++i) s.face[i + 1] = sponge && i >= start ? 1.0 : blend;
   return s;
 }
 

@@ -76,7 +76,7 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
   }
   for (std::size_t q = 0; q < in.fiber_u_index.size(); ++q) {
     const auto [i, j] = face_of(0, in.fiber_u_index[q]);
-    if (i >= m_i0 && i < nx) m_u(i, j) += dt * ri * in.fiber_u_force[q];
+    if (i >= m_iu0 && i < m_iu1) m_u(i, j) += dt * ri * in.fiber_u_force[q];
   }
   for (std::size_t q = 0; q < in.fiber_v_index.size(); ++q) {
     const auto [i, j] = face_of(1, in.fiber_v_index[q]);

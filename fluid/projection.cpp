@@ -40,16 +40,14 @@ void Solver::project(double dt, double t_new) {
   }
   // The face pressure of p^(n+1) (from u~ where it depends on the velocity), and of p^n as its
   // ghost holds it: phi_b is their difference, row by row.
-  const FacePressure p_new = face_pressure(t_new);
-  FacePressure phi_b;
+  face_pressure(t_new);
   for (int s : {int(left), int(right)}) {
     if (!m_bnd.is_pressure(s)) continue;
     const int i = s == left ? 0 : nx - 1, g = s == left ? -1 : nx;
     const double coef = 2.0 * xwi[i] * xwi[i];
-    phi_b[s].resize(ny);
     for (int j = 0; j < ny; ++j) {
-      phi_b[s][j] = p_new[s][j] - 0.5 * (m_p(g, j) + m_p(i, j));
-      buf[buf_index(i, j, 0, 0, nt)] -= coef * phi_b[s][j];
+      m_phi_b[s][j] = m_face_p[s][j] - 0.5 * (m_p(g, j) + m_p(i, j));
+      buf[buf_index(i, j, 0, 0, nt)] -= coef * m_phi_b[s][j];
     }
   }
   {
@@ -65,8 +63,8 @@ void Solver::project(double dt, double t_new) {
       p[i] += phi[i];
     }
   }
-  m_bnd.fill_scalar(m_phi, phi_b);
-  m_bnd.fill_scalar(m_p, p_new);
+  m_bnd.fill_scalar(m_phi, m_phi_b);
+  m_bnd.fill_scalar(m_p, m_face_p);
   const double c = dt / m_cfg.density;
   for (int j = 0; j < ny; ++j) {
     double* u = m_u.row(j);
@@ -84,10 +82,15 @@ void Solver::project(double dt, double t_new) {
 
 void Solver::project_initial() {
   m_bnd.advance_normal(m_u, m_v, m_t, 0.0);
+  // The face pressures of the current u in the ghosts first (a total-pressure face depends on
+  // it): the projection then moves no face pressure (phi_b = 0).
+  face_pressure(m_t);
+  m_bnd.fill_scalar(m_p, m_face_p);
   const Field p = m_p;
   project(1.0, m_t);
   m_p = p;
-  m_bnd.fill_scalar(m_p, face_pressure(m_t));
+  face_pressure(m_t);
+  m_bnd.fill_scalar(m_p, m_face_p);
   m_bnd.fill_ghosts(m_u, m_v);
 }
 

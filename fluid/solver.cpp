@@ -136,15 +136,17 @@ Solver::Solver(const Config& c, double dt)
     build_implicit(dt);
   }
   m_bnd.fill_ghosts(m_u, m_v);
-  m_bnd.fill_scalar(m_p, face_pressure(m_t));
+  for (int s : {int(left), int(right)})
+    if (m_bnd.is_pressure(s)) m_face_p[s].assign(ny, 0.0), m_phi_b[s].assign(ny, 0.0);
+  face_pressure(m_t);
+  m_bnd.fill_scalar(m_p, m_face_p);
 }
 
 Solver::~Solver() = default;
 
 // p_b(t) per row; with `total`, p_b(t) - rho u^2 / 2 on the rows where u enters (u > 0 on the
 // left face, u < 0 on the right), u the face's current normal velocity.
-FacePressure Solver::face_pressure(double t) const {
-  FacePressure f;
+void Solver::face_pressure(double t) {
   const int nx = m_grid.nx(), ny = m_grid.ny();
   for (int s : {int(left), int(right)}) {
     if (!m_bnd.is_pressure(s)) continue;
@@ -152,15 +154,12 @@ FacePressure Solver::face_pressure(double t) const {
     const double pb = b.boundary_pressure(t);
     const int i = s == left ? 0 : nx;
     const double inward = s == left ? 1.0 : -1.0;
-    std::vector<double>& v = f[s];
-    v.assign(ny, pb);
-    if (!b.total) continue;
+    std::vector<double>& v = m_face_p[s];
     for (int j = 0; j < ny; ++j) {
       const double un = inward * m_u(i, j);
-      if (un > 0) v[j] -= 0.5 * m_cfg.density * un * un;
+      v[j] = b.total && un > 0 ? pb - 0.5 * m_cfg.density * un * un : pb;
     }
   }
-  return f;
 }
 
 // Helmholtz operators of Crank-Nicolson: (L - 2/(nu dt)) for u and for v.

@@ -131,7 +131,8 @@ class Solver {
   void immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out);  // forcing.cpp
   // dt, and the time whose boundary pressures p^(n+1) takes (t^n + dt; t^n for project_initial).
   void project(double dt, double t_new);                                    // projection.cpp
-  FacePressure face_pressure(double t) const;                               // solver.cpp
+  // The face pressures at time t into m_face_p (pressure sides; per row; solver.cpp).
+  void face_pressure(double t);
   void keep_predictor();                                                     // solver.cpp
   void restore_predictor();                                                  // solver.cpp
   void correct(double dt, const CouplingIn& in, CouplingOut& out);           // solver.cpp
@@ -154,6 +155,9 @@ class Solver {
   // u faces the predictor and the projection step: [m_iu0, m_iu1) (the interior, and the
   // boundary faces of pressure sides).
   int m_iu0 = 0, m_iu1 = 0;
+  // Pressure sides: the face pressure of the projection's p^(n+1) and its increment phi_b, per
+  // row (sized once; empty without pressure sides).
+  FacePressure m_face_p, m_phi_b;
   double m_t = 0, m_dt_prev = 0, m_dt_implicit = 0;
   long m_step = 0;
   double m_nu = 0;

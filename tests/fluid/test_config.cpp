@@ -100,6 +100,13 @@ TEST_CASE("unknown keys are errors", "[fluid][config]") {
 }
 
 
+TEST_CASE("upwind_blend: read, and refused outside [0, 1]", "[fluid][config][upwind]") {
+  CHECK(read(kGood).upwind_blend == 0.0);
+  CHECK(read(replace(kGood, "viscosity = 0.01", "viscosity = 0.01\nupwind_blend = 0.2")).upwind_blend == 0.2);
+  CHECK_THROWS_WITH(read(replace(kGood, "viscosity = 0.01", "viscosity = 0.01\nupwind_blend = 1.5")),
+                    Contains("upwind_blend") && Contains("1.5"));
+}
+
 TEST_CASE("pressure boundaries: where they are allowed", "[fluid][config][pressure]") {
   std::string open = replace(kGood, "left = { type = \"periodic\" }",
                              "left = { type = \"pressure\", value = 2.0, ramp = \"cosine\", ramp_time = 0.5 }");
