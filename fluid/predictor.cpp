@@ -36,9 +36,9 @@ void Solver::predictor(double dt, double t_half) {
     }
     // A pressure side's boundary face: the explicit terms of its interior neighbour, the
     // gradient to the face pressure p_b(t^n) (the ghost p_{-1} = 2 p_b - p_0: xdi = 1 / w_0).
-    if (m_iu0 == 0 && m_i0 == 1)
+    if (m_bnd.is_pressure(left))
       u[0] += dt * (c1 * h[1] + c0 * ho[1] + acc[0] - ri * (p[0] - p[-1]) * xdi[0]);
-    if (m_iu1 == nx + 1)
+    if (m_bnd.is_pressure(right))
       u[nx] += dt * (c1 * h[nx - 1] + c0 * ho[nx - 1] + acc[0] - ri * (p[nx] - p[nx - 1]) * xdi[nx]);
   }
   for (int j = m_j0; j < ny; ++j) {

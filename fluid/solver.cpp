@@ -70,7 +70,7 @@ Operator1D make_operator(const Axis& ax, Loc loc, bool transform, const Boundari
   } else {
     for (int e = 0; e < 2; ++e) {
       const int side = side_lo + e;
-      const bool slip = b.side(side).type == BcType::slip || b.is_pressure(side);
+      const bool slip = b.side(side).type == BcType::slip;
       (e == 0 ? op.lo : op.hi) = slip ? Closure::neumann_half : Closure::dirichlet_half;
       // Fold the ghost rule g = ga q0 + gb q1 (+ data, on the right-hand side) into the row.
       const GhostRule& r = b.rule(side);

@@ -6,9 +6,12 @@ import os
 import numpy as np
 
 
-def table(path):
-    """A CSV with a header row as a numpy record array (columns by name, dots kept: t["A.ux"])."""
-    return np.atleast_1d(np.genfromtxt(path, delimiter=",", names=True, deletechars=""))
+def table(path, in_progress=False):
+    """A CSV with a header row as a numpy record array (columns by name, dots kept: t["A.ux"]).
+    in_progress: the file of a run still writing it, whose last line may be torn: a row without
+    every column is left out instead of an error."""
+    return np.atleast_1d(np.genfromtxt(path, delimiter=",", names=True, deletechars="",
+                                       invalid_raise=not in_progress))
 
 
 def summary(folder):

@@ -23,6 +23,7 @@ import json
 import os
 import sys
 import time
+import warnings
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
 import cli  # noqa: E402
@@ -233,21 +234,14 @@ TENTH = (0.05, 0.2)
 
 
 def read_csv(path):
-    """A CSV with a header row as {column: array}; a last line still being written is dropped
-    (the sweep also reads runs in progress). None without the file or a data row."""
+    """outputs.table of a run that may still be writing (the sweep also reads runs in progress),
+    as {column: array}; None without the file or a data row."""
     if not os.path.exists(path):
         return None
-    with open(path) as f:
-        names = f.readline().strip().split(",")
-    try:
-        a = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    except ValueError:  # a torn last line
-        with open(path) as f:
-            lines = f.readlines()[1:]
-        a = np.loadtxt(lines[:-1], delimiter=",", ndmin=2)
-    if len(a) == 0:
-        return None
-    return {n: a[:, k] for k, n in enumerate(names)}
+    with warnings.catch_warnings():  # a torn last line: left out, said by numpy as a warning
+        warnings.simplefilter("ignore")
+        a = outputs.table(path, in_progress=True)
+    return {n: a[n] for n in a.dtype.names} if a.size and a.dtype.names else None
 
 
 def locked(folder):
