@@ -29,7 +29,7 @@ DIAMETER = 0.25
 RHO_F = 1.0
 RHO_S = 1.25
 MU = 0.1
-LAMBDA = 0.1  # nu dt / h^2, explicit diffusion (its limit is 0.25 on square cells)
+LAMBDA = 0.1  # nu dt / h^2, explicit diffusion (its limit is 0.125 on square cells)
 T_END = 0.7   # the velocity peaks near t = 0.55-0.6 and has fallen by some per cent at 0.7
 GRIDS = [32] if SHORT else [32, 64, 128]  # cells per unit length
 # Published maximum particle Reynolds number (Glowinski et al. 2001, Wan & Turek 2006, as quoted
