@@ -5,6 +5,7 @@
 // (int64) followed by its elements; a string is its length then its bytes.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -53,8 +54,13 @@ const char* tag_name(Tag t);
 
 // ---- byte buffer ------------------------------------------------------------------------------
 
+// Writes a message into a caller's buffer from its start. The buffer keeps its size between
+// messages (a link packs every message of a step into the same one), so that steady traffic
+// allocates, zero-fills and faults in its pages once; size() is the message's length, which may
+// be less than the buffer's.
 class Writer {
  public:
+  explicit Writer(std::vector<std::byte>& buffer) : m_bytes(buffer) {}
   template <class T>
   void put(const T& x) {
     static_assert(std::is_trivially_copyable_v<T>);
@@ -67,16 +73,16 @@ class Writer {
     append(v.data(), v.size() * sizeof(T));
   }
   void put(const std::string& s);
-  const std::vector<std::byte>& bytes() const { return m_bytes; }
-  std::vector<std::byte>& bytes() { return m_bytes; }
+  std::size_t size() const { return m_size; }
 
  private:
   void append(const void* p, std::size_t n) {
-    const std::size_t old = m_bytes.size();
-    m_bytes.resize(old + n);
-    if (n) std::memcpy(m_bytes.data() + old, p, n);
+    if (m_size + n > m_bytes.size()) m_bytes.resize(std::max(m_size + n, 2 * m_bytes.size()));
+    if (n) std::memcpy(m_bytes.data() + m_size, p, n);
+    m_size += n;
   }
-  std::vector<std::byte> m_bytes;
+  std::vector<std::byte>& m_bytes;
+  std::size_t m_size = 0;
 };
 
 class Reader {
@@ -287,12 +293,23 @@ struct FiberState {  // fiber -> coupler, at set-up and after every step
   void unpack(Reader& r);
 };
 
-// Whole-message packing with the header; unpack checks magic, version, tag, and that every byte
-// was read.
+// Whole-message packing with the header into `buffer` (from its start; returns the message's
+// length); unpack checks magic, version, tag, and that every byte was read.
 template <class M>
-std::vector<std::byte> pack_message(const M& m, std::int64_t step);
+std::size_t pack_message(const M& m, std::int64_t step, std::vector<std::byte>& buffer);
 template <class M>
-void unpack_message(const std::vector<std::byte>& bytes, M& m, std::int64_t* step = nullptr);
+void unpack_message(const std::byte* bytes, std::size_t size, M& m, std::int64_t* step = nullptr);
+// The same with a buffer of the message's own length.
+template <class M>
+std::vector<std::byte> pack_message(const M& m, std::int64_t step) {
+  std::vector<std::byte> bytes;
+  bytes.resize(pack_message(m, step, bytes));
+  return bytes;
+}
+template <class M>
+void unpack_message(const std::vector<std::byte>& bytes, M& m, std::int64_t* step = nullptr) {
+  unpack_message(bytes.data(), bytes.size(), m, step);
+}
 
 struct Header {
   std::uint32_t magic = kMagic;
@@ -309,19 +326,19 @@ Tag message_tag(const M& m) {
 }
 
 template <class M>
-std::vector<std::byte> pack_message(const M& m, std::int64_t step) {
-  Writer w;
+std::size_t pack_message(const M& m, std::int64_t step, std::vector<std::byte>& buffer) {
+  Writer w(buffer);
   Header h;
   h.tag = message_tag(m);
   h.step = step;
   w.put(h);
   m.pack(w);
-  return std::move(w.bytes());
+  return w.size();
 }
 
 template <class M>
-void unpack_message(const std::vector<std::byte>& bytes, M& m, std::int64_t* step) {
-  Reader r(bytes.data(), bytes.size());
+void unpack_message(const std::byte* bytes, std::size_t size, M& m, std::int64_t* step) {
+  Reader r(bytes, size);
   Header h;
   r.get(h);
   if (h.magic != kMagic) fail("protocol error: bad message magic {:#x}", h.magic);

@@ -335,9 +335,9 @@ std::filesystem::path choose_out_dir(const std::filesystem::path& root, const st
 
 // ---- Link -------------------------------------------------------------------------------------
 
-void Link::send_bytes(const std::vector<std::byte>& bytes, proto::Tag tag) {
+void Link::send_bytes(std::size_t size, proto::Tag tag) {
   MPI_Request req;
-  MPI_Isend(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, 0, static_cast<int>(tag), m_comm,
+  MPI_Isend(m_out.data(), static_cast<int>(size), MPI_BYTE, 0, static_cast<int>(tag), m_comm,
             &req);
   wait_until(
       [&] {
@@ -347,10 +347,10 @@ void Link::send_bytes(const std::vector<std::byte>& bytes, proto::Tag tag) {
       },
       [&] { return fmt::format("delivery of message '{}' to {}", proto::tag_name(tag), role_name(m_peer)); },
       m_peer == Role::coupler ? 1.5 : 1.0);
-  m_sent += bytes.size();
+  m_sent += size;
 }
 
-std::vector<std::byte> Link::recv_bytes(proto::Tag expected) {
+std::size_t Link::recv_bytes(proto::Tag expected) {
   int flag = 0;
   MPI_Message msg;
   MPI_Status status;
@@ -366,10 +366,11 @@ std::vector<std::byte> Link::recv_bytes(proto::Tag expected) {
          role_name(m_peer), proto::tag_name(static_cast<proto::Tag>(status.MPI_TAG)));
   int count = 0;
   MPI_Get_count(&status, MPI_BYTE, &count);
-  std::vector<std::byte> bytes(static_cast<std::size_t>(count));
-  MPI_Mrecv(bytes.data(), count, MPI_BYTE, &msg, MPI_STATUS_IGNORE);
-  m_received += bytes.size();
-  return bytes;
+  const auto size = static_cast<std::size_t>(count);
+  if (m_in.size() < size) m_in.resize(std::max(size, 2 * m_in.size()));
+  MPI_Mrecv(m_in.data(), count, MPI_BYTE, &msg, MPI_STATUS_IGNORE);
+  m_received += size;
+  return size;
 }
 
 // ---- Runtime ----------------------------------------------------------------------------------

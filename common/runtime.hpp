@@ -79,16 +79,17 @@ class Link {
  public:
   Link(MPI_Comm inter, Role peer) : m_comm(inter), m_peer(peer) {}
   Role peer() const { return m_peer; }
-  void send_bytes(const std::vector<std::byte>& bytes, proto::Tag tag);
-  std::vector<std::byte> recv_bytes(proto::Tag expected);
+  // The first `size` bytes of m_out; a received message into m_in, returning its length.
+  void send_bytes(std::size_t size, proto::Tag tag);
+  std::size_t recv_bytes(proto::Tag expected);
   template <class M>
   void send(const M& m, std::int64_t step = 0) {
-    send_bytes(proto::pack_message(m, step), proto::message_tag(m));
+    send_bytes(proto::pack_message(m, step, m_out), proto::message_tag(m));
   }
   template <class M>
   void recv(M& m, std::int64_t* step = nullptr) {
-    const auto bytes = recv_bytes(proto::message_tag(m));
-    proto::unpack_message(bytes, m, step);
+    const std::size_t size = recv_bytes(proto::message_tag(m));
+    proto::unpack_message(m_in.data(), size, m, step);
   }
   std::uint64_t bytes_sent() const { return m_sent; }
   std::uint64_t bytes_received() const { return m_received; }
@@ -97,6 +98,9 @@ class Link {
   MPI_Comm m_comm;
   Role m_peer;
   std::uint64_t m_sent = 0, m_received = 0;
+  // Kept between messages (see proto::Writer): a send completes before send() returns, and a
+  // received message is unpacked before the next is received.
+  std::vector<std::byte> m_out, m_in;
 };
 
 class Runtime {

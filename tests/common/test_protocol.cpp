@@ -129,3 +129,34 @@ TEST_CASE("damaged or mismatched messages are refused") {
     CHECK_THROWS_WITH(unpack_message(b, back), Catch::Contains("does not fit"));
   }
 }
+
+// A link packs every message into one kept buffer: a short message after a long one must carry
+// its own length only, and the buffer grows once, not per message.
+TEST_CASE("messages packed one after another into a kept buffer") {
+  std::vector<std::byte> buffer;
+  FluidInput big;
+  big.sample_u.assign(5000, 3);
+  big.force_u.index.assign(2000, 4), big.force_u.force.assign(2000, -1.5);
+  const std::size_t n_big = pack_message(big, 3, buffer);
+  CHECK(buffer.size() >= n_big);
+  const auto* data = buffer.data();
+  StepBegin sb{4, 0.4, 0.1, Action::stop};
+  const std::size_t n_small = pack_message(sb, 4, buffer);
+  CHECK(n_small < n_big);
+  CHECK(buffer.data() == data);  // no reallocation for the shorter message
+  StepBegin back;
+  std::int64_t step = -1;
+  unpack_message(buffer.data(), n_small, back, &step);
+  CHECK(step == 4);
+  CHECK(back.action == Action::stop);
+  CHECK(back.time == 0.4);
+  // The long message again, over the short one's bytes: equal to a freshly packed copy.
+  const std::size_t n_again = pack_message(big, 3, buffer);
+  const auto fresh = pack_message(big, 3);
+  REQUIRE(n_again == fresh.size());
+  CHECK(std::memcmp(buffer.data(), fresh.data(), n_again) == 0);
+  FluidInput big2;
+  unpack_message(buffer.data(), n_again, big2);
+  CHECK(big2.sample_u == big.sample_u);
+  CHECK(big2.force_u.force == big.force_u.force);
+}
