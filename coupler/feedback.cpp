@@ -48,8 +48,10 @@ void Coupler::feedback_forces() {
       F[m] = m_kappa * (dt * m_u_markers[m] - (X[m] - Xo[m]));
     m_ib->spread(X, F, m_layout.fibers[k].ds);
   }
-  m_ib->take_spread(m_fluid_in.force_u, m_fluid_in.force_v);
+  // The next step's samples: the kernels of Xⁿ widened by a cell, which hold the faces spread to.
   m_ib->stencil(m_fiber.x, 1, m_fluid_in.sample_u, m_fluid_in.sample_v);
+  m_ib->take_spread(m_fluid_in.sample_u, m_fluid_in.sample_v, m_fluid_in.force_u,
+                    m_fluid_in.force_v);
   m_phases.stop("fibers");
 }
 

@@ -56,6 +56,19 @@ FeedbackIB::FeedbackIB(const proto::GridInfo& g) {
   }
 }
 
+// The four face indices from i0 along a direction of n faces: wrapped once and then stepped
+// (an integer division per face would cost more than the kernel's arithmetic), or −1 outside a
+// bounded direction.
+static void face_run(int i0, int n, bool periodic, int out[4]) {
+  if (periodic) {
+    int i = i0 % n;
+    if (i < 0) i += n;
+    for (int k = 0; k < 4; ++k, i = i + 1 == n ? 0 : i + 1) out[k] = i;
+  } else {
+    for (int k = 0; k < 4; ++k) out[k] = (i0 + k < 0 || i0 + k >= n) ? -1 : i0 + k;
+  }
+}
+
 void FeedbackIB::kernel(const Family& f, double X, double Y, std::int32_t idx[16], double w[16]) const {
   const double sx = (X - f.x0) / m_hx, sy = (Y - f.y0) / m_hy;
   const int i0 = static_cast<int>(std::floor(sx)) - 1, j0 = static_cast<int>(std::floor(sy)) - 1;
@@ -63,14 +76,8 @@ void FeedbackIB::kernel(const Family& f, double X, double Y, std::int32_t idx[16
   int ii[4], jj[4];
   peskin4_weights(sx - (i0 + 1), wx);
   peskin4_weights(sy - (j0 + 1), wy);
-  for (int k = 0; k < 4; ++k) {
-    int i = i0 + k, j = j0 + k;
-    if (f.px) i = ((i % f.ni) + f.ni) % f.ni;
-    else if (i < 0 || i >= f.ni) i = -1;
-    if (f.py) j = ((j % f.nj) + f.nj) % f.nj;
-    else if (j < 0 || j >= f.nj) j = -1;
-    ii[k] = i, jj[k] = j;
-  }
+  face_run(i0, f.ni, f.px, ii);
+  face_run(j0, f.nj, f.py, jj);
   for (int b = 0; b < 4; ++b)
     for (int a = 0; a < 4; ++a) {
       idx[4 * b + a] = (ii[a] < 0 || jj[b] < 0) ? -1 : ii[a] + f.ni * jj[b];
@@ -81,11 +88,20 @@ void FeedbackIB::kernel(const Family& f, double X, double Y, std::int32_t idx[16
 // Each face is marked once and listed; where the marks lie in a narrow index range (the faces of a
 // fiber layer in a band of rows) the sorted list is read off them, else the list is sorted (fibers
 // far apart in y, or across a periodic y boundary): the cost follows the footprint, not the grid.
-// Needs no spread() pending (feedback_forces takes the spread before asking for the stencil).
 void FeedbackIB::stencil(const std::vector<std::vector<double>>& markers, int margin,
                          std::vector<std::int32_t>& u_faces, std::vector<std::int32_t>& v_faces) {
+  const int width = 4 + 2 * margin;
+  std::vector<int> cols(static_cast<std::size_t>(width)), rows(static_cast<std::size_t>(width));
+  // Indices of `width` faces from k0 along a direction of n faces, wrapped once and stepped.
+  auto run = [width](int k0, int n, bool periodic, std::vector<int>& out) {
+    int k = k0;
+    if (periodic) k = ((k % n) + n) % n;
+    for (int c = 0; c < width; ++c, ++k) {
+      if (periodic && k == n) k = 0;
+      out[c] = (k < 0 || k >= n) ? -1 : k;
+    }
+  };
   for (auto [f, out] : {std::pair{&m_u, &u_faces}, std::pair{&m_v, &v_faces}}) {
-    FSI_ASSERT(f->hi < 0);  // no spread() waiting for take_spread()
     out->clear();
     std::int32_t lo = std::numeric_limits<std::int32_t>::max(), hi = -1;
     for (const auto& x : markers) {
@@ -96,14 +112,12 @@ void FeedbackIB::stencil(const std::vector<std::vector<double>>& markers, int ma
         // Markers closer than a cell often share their cell, and so their window.
         if (m > 0 && ic == ic_prev && jc == jc_prev) continue;
         ic_prev = ic, jc_prev = jc;
-        for (int j = jc - 1 - margin; j <= jc + 2 + margin; ++j) {
-          int b = j;
-          if (f->py) b = ((b % f->nj) + f->nj) % f->nj;
-          else if (b < 0 || b >= f->nj) continue;
-          for (int i = ic - 1 - margin; i <= ic + 2 + margin; ++i) {
-            int a = i;
-            if (f->px) a = ((a % f->ni) + f->ni) % f->ni;
-            else if (a < 0 || a >= f->ni) continue;
+        run(ic - 1 - margin, f->ni, f->px, cols);
+        run(jc - 1 - margin, f->nj, f->py, rows);
+        for (const int b : rows) {
+          if (b < 0) continue;
+          for (const int a : cols) {
+            if (a < 0) continue;
             const std::int32_t k = a + f->ni * b;
             if (f->mark[k]) continue;
             f->mark[k] = 1;
@@ -185,31 +199,31 @@ void FeedbackIB::spread(const std::vector<double>& x, const std::vector<double>&
   for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
     const double scale = -(m == 0 || m == last ? 0.5 * ds : ds) / (m_hx * m_hy);
     for (int c = 0; c < 2; ++c) {
-      Family& f = c == 0 ? m_u : m_v;
+      double* force = (c == 0 ? m_u : m_v).force.data();
       const std::int32_t* idx = &m_idx[16 * m + 16 * c];
       const double* w = &m_w[16 * m + 16 * c];
-      for (int k = 0; k < 16; ++k) {
-        if (idx[k] < 0 || w[k] == 0) continue;
-        if (!f.mark[idx[k]]) f.mark[idx[k]] = 1, f.touched.push_back(idx[k]);
-        f.lo = std::min(f.lo, idx[k]), f.hi = std::max(f.hi, idx[k]);
-        f.force[idx[k]] += scale * F[m + c] * w[k];
-      }
+      const double s = scale * F[m + c];
+      for (int k = 0; k < 16; ++k)
+        if (idx[k] >= 0) force[idx[k]] += s * w[k];
     }
   }
 }
 
-// The touched faces in index order (as stencil()) with their forces, then cleared.
-void FeedbackIB::take_spread(proto::FaceForce& u, proto::FaceForce& v) {
-  for (auto [f, out] : {std::pair{&m_u, &u}, std::pair{&m_v, &v}}) {
-    scan_or_sort(f->mark, f->lo, f->hi, f->touched);
-    out->index = f->touched;
-    out->force.resize(f->touched.size());
-    for (std::size_t k = 0; k < f->touched.size(); ++k) {
-      out->force[k] = f->force[f->touched[k]];
-      f->force[f->touched[k]] = 0;
+// Every face a spread() touched lies in the stencil of its markers (the same 4 × 4 windows), so
+// the stencil's list, in index order, is read for the forces; faces whose force is exactly zero
+// carry nothing and are left out.
+void FeedbackIB::take_spread(const std::vector<std::int32_t>& u_faces,
+                             const std::vector<std::int32_t>& v_faces, proto::FaceForce& u,
+                             proto::FaceForce& v) {
+  for (auto [f, faces, out] : {std::tuple{&m_u, &u_faces, &u}, std::tuple{&m_v, &v_faces, &v}}) {
+    out->index.clear();
+    out->force.clear();
+    for (const std::int32_t k : *faces) {
+      if (f->force[k] == 0) continue;
+      out->index.push_back(k);
+      out->force.push_back(f->force[k]);
+      f->force[k] = 0;
     }
-    f->touched.clear();
-    f->lo = std::numeric_limits<std::int32_t>::max(), f->hi = -1;
   }
 }
 

@@ -51,10 +51,13 @@ class FeedbackIB {
   // The force per unit volume on the fluid from forces per unit length F on the markers of one
   // fiber of spacing ds: f(x_f) = −Σ_m F_m w_m φ(..)φ(..)/(h_x h_y), with the marker's arclength
   // w_m = ds inside and ds/2 at the two ends (the weights the fiber integrates its loads with, so
-  // that action = reaction), accumulated per face and the touched faces recorded.
+  // that action = reaction), accumulated per face.
   void spread(const std::vector<double>& x, const std::vector<double>& F, double ds);
-  // The accumulated spread force as sparse face lists (sorted), then cleared.
-  void take_spread(proto::FaceForce& u, proto::FaceForce& v);
+  // The accumulated spread force as sparse face lists (sorted), then cleared. u_faces, v_faces:
+  // a stencil() (any margin) of every marker spread since the last take: it holds every face
+  // they touched.
+  void take_spread(const std::vector<std::int32_t>& u_faces, const std::vector<std::int32_t>& v_faces,
+                   proto::FaceForce& u, proto::FaceForce& v);
 
   double hx() const { return m_hx; }
   double hy() const { return m_hy; }
@@ -66,10 +69,8 @@ class FeedbackIB {
     bool px = false, py = false; // periodic
     std::vector<double> value;   // sampled velocity per face
     std::vector<char> has_value;
-    std::vector<double> force;   // spread force per face
-    std::vector<char> mark;      // face listed (stencil(), cleared there) or touched by spread()
-    std::vector<std::int32_t> touched;  // spread()'s faces, until take_spread()
-    std::int32_t lo = std::numeric_limits<std::int32_t>::max(), hi = -1;  // their index range
+    std::vector<double> force;   // spread force per face, until take_spread()
+    std::vector<char> mark;      // face listed (within stencil() only)
   };
   // The 4 × 4 kernel of point (X, Y) on a family: face indices (−1 outside a bounded grid) and
   // weights φ φ.

@@ -115,8 +115,10 @@ TEST_CASE("spreading conserves force and is the transpose of interpolation") {
   }
   const double ds = 0.01;
   ib.spread(x, F, ds);
+  std::vector<std::int32_t> su, sv;
+  ib.stencil({x}, 0, su, sv);
   proto::FaceForce fu, fv;
-  ib.take_spread(fu, fv);
+  ib.take_spread(su, sv, fu, fv);
   const double cell = ib.hx() * ib.hy();
   double sx = 0, sy = 0, tx = 0, ty = 0, scale = 0;
   for (double f : fu.force) sx += f * cell, scale += std::abs(f * cell);
@@ -128,8 +130,6 @@ TEST_CASE("spreading conserves force and is the transpose of interpolation") {
   CHECK(std::abs(sy + ty) <= 1e-12 * scale);
 
   // <spread(F), u>_grid = −<F, interp(u)>_markers for an arbitrary velocity u.
-  std::vector<std::int32_t> su, sv;
-  ib.stencil({x}, 0, su, sv);
   std::vector<double> u(su.size()), v(sv.size());
   for (auto& a : u) a = r(rng);
   for (auto& a : v) a = r(rng);
