@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "error.hpp"
+#include "sorted_marks.hpp"
 
 namespace coupler {
 
@@ -127,24 +128,9 @@ void FeedbackIB::stencil(const std::vector<std::vector<double>>& markers, int ma
         }
       }
     }
-    scan_or_sort(f->mark, lo, hi, *out);
+    sort_marked(*out, lo, hi, [f](std::int32_t k) { return f->mark[k] != 0; });
+    for (const std::int32_t k : *out) f->mark[k] = 0;
   }
-}
-
-// The marked indices (listed in `list` in any order) sorted, and their marks cleared: read off the
-// marks from lo to hi when that range is at most kScanFactor times the list, else sorted.
-void FeedbackIB::scan_or_sort(std::vector<char>& mark, std::int32_t lo, std::int32_t hi,
-                              std::vector<std::int32_t>& list) {
-  constexpr std::int64_t kScanFactor = 8;
-  if (list.empty()) return;
-  if (std::int64_t(hi) - lo + 1 <= kScanFactor * std::int64_t(list.size())) {
-    list.clear();
-    for (std::int32_t k = lo; k <= hi; ++k)
-      if (mark[k]) list.push_back(k), mark[k] = 0;
-    return;
-  }
-  std::sort(list.begin(), list.end());
-  for (const std::int32_t k : list) mark[k] = 0;
 }
 
 void FeedbackIB::store_samples(const std::vector<std::int32_t>& u_faces, const std::vector<double>& u,

@@ -78,8 +78,6 @@ class FeedbackIB {
   // The kernels of both families at every marker of x into m_idx, m_w (16 per marker and family),
   // unless they are those of the same x already.
   void kernels(const std::vector<double>& x) const;
-  static void scan_or_sort(std::vector<char>& mark, std::int32_t lo, std::int32_t hi,
-                           std::vector<std::int32_t>& list);
 
   double m_hx, m_hy, m_lx, m_ly;
   Family m_u, m_v;

@@ -4,10 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <limits>
 #include <thread>
 
 #include "clip.hpp"
 #include "error.hpp"
+#include "sorted_marks.hpp"
 
 namespace coupler {
 
@@ -202,9 +204,13 @@ void ImmersedSolid::clip_body(const FaceBoxes& boxes, const EdgeIndex& ix, const
 void ImmersedSolid::touched_faces(const Raw& raw, std::vector<std::int32_t>& slot,
                                   std::vector<std::int32_t>& face) {
   face.clear();
+  std::int32_t lo = std::numeric_limits<std::int32_t>::max(), hi = -1;
   for (const Piece& q : raw)
-    if (slot[q.face] < 0) slot[q.face] = 0, face.push_back(q.face);
-  std::sort(face.begin(), face.end());
+    if (slot[q.face] < 0) {
+      slot[q.face] = 0, face.push_back(q.face);
+      lo = std::min(lo, q.face), hi = std::max(hi, q.face);
+    }
+  sort_marked(face, lo, hi, [&slot](std::int32_t k) { return slot[k] == 0; });
 }
 
 // Once, after the fixed bodies are clipped: their faces (sorted), each face's area and each
