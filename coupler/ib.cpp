@@ -18,7 +18,7 @@ double peskin4(double r) {
 }
 
 void peskin4_weights(double r, double w[4]) {
-  const double q = std::sqrt(std::max(0.0, 1 + 4 * r - 4 * r * r));
+  const double q = std::sqrt(1 + 4 * r - 4 * r * r);  // in [1, √2] for r in [0, 1]
   w[0] = (3 - 2 * r - q) / 8;
   w[1] = (3 - 2 * r + q) / 8;
   w[2] = (1 + 2 * r + q) / 8;
@@ -26,6 +26,12 @@ void peskin4_weights(double r, double w[4]) {
 }
 
 namespace {
+// ⌊s⌋ for |s| within int's range, without a call to floor (not inlined on the baseline x86-64).
+inline int floor_int(double s) {
+  const int i = static_cast<int>(s);
+  return i - (s < i);
+}
+
 // Spacings within this fraction of their mean count as equal: round-off of the face coordinates,
 // not a stretching.
 constexpr double kUniform = 1e-9;
@@ -52,8 +58,9 @@ FeedbackIB::FeedbackIB(const proto::GridInfo& g) {
   m_v.x0 = g.x_face[0] + 0.5 * m_hx, m_v.y0 = g.y_face[0];
   for (Family* f : {&m_u, &m_v}) {
     f->px = g.periodic_x != 0, f->py = g.periodic_y != 0;
-    const std::size_t n = static_cast<std::size_t>(f->ni) * f->nj;
-    f->value.assign(n, 0.0), f->has_value.assign(n, 0), f->force.assign(n, 0.0), f->mark.assign(n, 0);
+    // One slot past the faces: `outside` (see Family).
+    const std::size_t n = static_cast<std::size_t>(f->ni) * f->nj + 1;
+    f->value.assign(n, 0.0), f->has_value.assign(n, 1), f->force.assign(n, 0.0), f->mark.assign(n, 0);
   }
 }
 
@@ -72,18 +79,21 @@ static void face_run(int i0, int n, bool periodic, int out[4]) {
 
 void FeedbackIB::kernel(const Family& f, double X, double Y, std::int32_t idx[16], double w[16]) const {
   const double sx = (X - f.x0) / m_hx, sy = (Y - f.y0) / m_hy;
-  const int i0 = static_cast<int>(std::floor(sx)) - 1, j0 = static_cast<int>(std::floor(sy)) - 1;
+  const int i0 = floor_int(sx) - 1, j0 = floor_int(sy) - 1;
   double wx[4], wy[4];
   int ii[4], jj[4];
   peskin4_weights(sx - (i0 + 1), wx);
   peskin4_weights(sy - (j0 + 1), wy);
   face_run(i0, f.ni, f.px, ii);
   face_run(j0, f.nj, f.py, jj);
-  for (int b = 0; b < 4; ++b)
+  const std::int32_t outside = f.ni * f.nj;
+  for (int b = 0; b < 4; ++b) {
+    const std::int32_t row = jj[b] < 0 ? -1 : f.ni * jj[b];
     for (int a = 0; a < 4; ++a) {
-      idx[4 * b + a] = (ii[a] < 0 || jj[b] < 0) ? -1 : ii[a] + f.ni * jj[b];
+      idx[4 * b + a] = (ii[a] < 0 || row < 0) ? outside : ii[a] + row;
       w[4 * b + a] = wx[a] * wy[b];
     }
+  }
 }
 
 // Each face is marked once and listed; where the marks lie in a narrow index range (the faces of a
@@ -103,33 +113,49 @@ void FeedbackIB::stencil(const std::vector<std::vector<double>>& markers, int ma
     }
   };
   for (auto [f, out] : {std::pair{&m_u, &u_faces}, std::pair{&m_v, &v_faces}}) {
+    // The windows' lower-left cells, one per run of markers in the same cell. Markers move far
+    // less than a cell per step, so most steps find the windows, and so the faces, of the last
+    // call: then its list is the answer.
+    auto& cells = f->window_scratch;
+    cells.clear();
+    for (const auto& x : markers) {
+      for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
+        const int ic = floor_int((x[m] - f->x0) / m_hx);
+        const int jc = floor_int((x[m + 1] - f->y0) / m_hy);
+        const std::size_t n = cells.size();
+        if (m > 0 && cells[n - 2] == ic && cells[n - 1] == jc) continue;
+        cells.push_back(ic), cells.push_back(jc);
+      }
+      cells.push_back(kFiberEnd), cells.push_back(kFiberEnd);
+    }
+    if (margin == f->window_margin && cells == f->windows) {
+      *out = f->window_faces;
+      continue;
+    }
     out->clear();
     std::int32_t lo = std::numeric_limits<std::int32_t>::max(), hi = -1;
-    for (const auto& x : markers) {
-      int ic_prev = 0, jc_prev = 0;
-      for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
-        const int ic = static_cast<int>(std::floor((x[m] - f->x0) / m_hx));
-        const int jc = static_cast<int>(std::floor((x[m + 1] - f->y0) / m_hy));
-        // Markers closer than a cell often share their cell, and so their window.
-        if (m > 0 && ic == ic_prev && jc == jc_prev) continue;
-        ic_prev = ic, jc_prev = jc;
-        run(ic - 1 - margin, f->ni, f->px, cols);
-        run(jc - 1 - margin, f->nj, f->py, rows);
-        for (const int b : rows) {
-          if (b < 0) continue;
-          for (const int a : cols) {
-            if (a < 0) continue;
-            const std::int32_t k = a + f->ni * b;
-            if (f->mark[k]) continue;
-            f->mark[k] = 1;
-            out->push_back(k);
-            lo = std::min(lo, k), hi = std::max(hi, k);
-          }
+    for (std::size_t w = 0; w < cells.size(); w += 2) {
+      const int ic = cells[w], jc = cells[w + 1];
+      if (ic == kFiberEnd) continue;
+      run(ic - 1 - margin, f->ni, f->px, cols);
+      run(jc - 1 - margin, f->nj, f->py, rows);
+      for (const int b : rows) {
+        if (b < 0) continue;
+        for (const int a : cols) {
+          if (a < 0) continue;
+          const std::int32_t k = a + f->ni * b;
+          if (f->mark[k]) continue;
+          f->mark[k] = 1;
+          out->push_back(k);
+          lo = std::min(lo, k), hi = std::max(hi, k);
         }
       }
     }
     sort_marked(*out, lo, hi, [f](std::int32_t k) { return f->mark[k] != 0; });
     for (const std::int32_t k : *out) f->mark[k] = 0;
+    f->windows.swap(cells);
+    f->window_margin = margin;
+    f->window_faces = *out;
   }
 }
 
@@ -138,7 +164,7 @@ void FeedbackIB::store_samples(const std::vector<std::int32_t>& u_faces, const s
   for (auto [f, idx, val] : {std::tuple{&m_u, &u_faces, &u}, std::tuple{&m_v, &v_faces, &v}}) {
     if (idx->size() != val->size())
       fsi::fail("protocol error: {} velocity samples for {} faces", val->size(), idx->size());
-    std::fill(f->has_value.begin(), f->has_value.end(), 0);
+    std::fill(f->has_value.begin(), f->has_value.end() - 1, 0);  // `outside` keeps its 1
     for (std::size_t k = 0; k < idx->size(); ++k) {
       f->value[(*idx)[k]] = (*val)[k];
       f->has_value[(*idx)[k]] = 1;
@@ -166,14 +192,15 @@ void FeedbackIB::interpolate(const std::vector<double>& x, std::vector<double>& 
       const std::int32_t* idx = &m_idx[16 * m + 16 * c];
       const double* w = &m_w[16 * m + 16 * c];
       double s = 0;
+      char sampled = 1;
       for (int k = 0; k < 16; ++k) {
-        if (idx[k] < 0 || w[k] == 0) continue;
-        if (!f.has_value[idx[k]])
-          fsi::fail("fiber marker at ({}, {}) moved beyond the sampled stencil in one step "
-                    "(more than a grid cell): reduce dt",
-                    x[m], x[m + 1]);
+        sampled &= f.has_value[idx[k]];
         s += w[k] * f.value[idx[k]];
       }
+      if (!sampled)
+        fsi::fail("fiber marker at ({}, {}) moved beyond the sampled stencil in one step "
+                  "(more than a grid cell): reduce dt",
+                  x[m], x[m + 1]);
       u[m + c] = s;
     }
   }
@@ -189,8 +216,7 @@ void FeedbackIB::spread(const std::vector<double>& x, const std::vector<double>&
       const std::int32_t* idx = &m_idx[16 * m + 16 * c];
       const double* w = &m_w[16 * m + 16 * c];
       const double s = scale * F[m + c];
-      for (int k = 0; k < 16; ++k)
-        if (idx[k] >= 0) force[idx[k]] += s * w[k];
+      for (int k = 0; k < 16; ++k) force[idx[k]] += s * w[k];
     }
   }
 }
@@ -202,6 +228,7 @@ void FeedbackIB::take_spread(const std::vector<std::int32_t>& u_faces,
                              const std::vector<std::int32_t>& v_faces, proto::FaceForce& u,
                              proto::FaceForce& v) {
   for (auto [f, faces, out] : {std::tuple{&m_u, &u_faces, &u}, std::tuple{&m_v, &v_faces, &v}}) {
+    f->force.back() = 0;  // `outside`: what the kernels put beyond a wall, dropped
     out->index.clear();
     out->force.clear();
     for (const std::int32_t k : *faces) {

@@ -67,13 +67,23 @@ class FeedbackIB {
     int ni = 0, nj = 0;          // faces along x, y; flat index i + ni*j
     double x0 = 0, y0 = 0;       // position of face (0, 0)
     bool px = false, py = false; // periodic
+    // Per face, and one slot more, `outside` = ni·nj: the kernels' faces beyond a bounded
+    // side, with value 0, always sampled, its spread force dropped; so that interpolation and
+    // spreading run without a branch per face.
     std::vector<double> value;   // sampled velocity per face
     std::vector<char> has_value;
     std::vector<double> force;   // spread force per face, until take_spread()
     std::vector<char> mark;      // face listed (within stencil() only)
+    // The last stencil(): its windows' cells (i, j per window, kFiberEnd twice after each
+    // fiber), margin and faces; and the scratch for the next call's cells.
+    std::vector<int> windows, window_scratch;
+    int window_margin = -1;
+    std::vector<std::int32_t> window_faces;
   };
-  // The 4 × 4 kernel of point (X, Y) on a family: face indices (−1 outside a bounded grid) and
-  // weights φ φ.
+  // Marks the end of a fiber in Family::windows (no cell index is this low).
+  static constexpr int kFiberEnd = std::numeric_limits<int>::min();
+  // The 4 × 4 kernel of point (X, Y) on a family: face indices (`outside` beyond a bounded
+  // side) and weights φ φ.
   void kernel(const Family& f, double X, double Y, std::int32_t idx[16], double w[16]) const;
   // The kernels of both families at every marker of x into m_idx, m_w (16 per marker and family),
   // unless they are those of the same x already.
