@@ -25,11 +25,20 @@ const char* type_name(BcType t) {
   return "?";
 }
 
+// The largest width ratio of neighbouring cells outside a band.
+constexpr double kMaxBandGrowth = 1.2;
+
 [[noreturn]] void bad(const Config& c, const std::string& msg) {
   throw fsi::InputError(c.source.empty() ? msg : fmt::format("{} (in {})", msg, c.source));
 }
 
 double min_width(const AxisSpec& a) {
+  if (a.band_cells > 0) {
+    const Axis ax(a);
+    double w = ax.width(0);
+    for (int i = 1; i < a.cells; ++i) w = std::min(w, ax.width(i));
+    return w;
+  }
   // tanh clustering: the first cell is the smallest.
   if (a.tanh_beta > 0) {
     const double x1 = 0.5 * a.length *
@@ -105,25 +114,59 @@ void validate(const Config& c, double dt) {
     }
   }
   const bool px = c.bc[left].type == BcType::periodic, py = c.bc[bottom].type == BcType::periodic;
-  const bool x_stretched = c.x.sponge_cells > 0 && c.x.sponge_ratio != 1.0;
-  const bool y_stretched = c.y.tanh_beta > 0;
+  const bool x_sponge = c.x.sponge_cells > 0 && c.x.sponge_ratio != 1.0;
+  const bool x_stretched = x_sponge || c.x.band_cells > 0;
+  const bool y_stretched = c.y.tanh_beta > 0 || c.y.band_cells > 0;
+  // Bands: where they fit, and a growth outside them smooth enough for the stencils (a width
+  // ratio of neighbouring cells far from 1 costs the interpolations their second order).
+  for (const auto& [a, name] : {std::pair{&c.x, "x_band"}, std::pair{&c.y, "y_band"}}) {
+    if (a->band_cells == 0) continue;
+    BandLayout l;
+    try {
+      l = band_layout(*a);
+    } catch (const fsi::Error& e) {
+      bad(c, fmt::format("fluid.grid.{}: {}", name, e.what()));
+    }
+    if (l.worst() > kMaxBandGrowth)
+      bad(c, fmt::format("fluid.grid.{} = {{ from = {:g}, to = {:g}, cells = {} }}: the {} cells "
+                         "outside it would change width by a factor {:.3g} from cell to cell (at "
+                         "most {:g}); give the direction more cells, the band fewer, or widen it",
+                         name, a->band_from, a->band_to, a->band_cells, a->cells - a->band_cells,
+                         l.worst(), kMaxBandGrowth));
+  }
+  if (c.x.band_cells > 0 && x_sponge)
+    bad(c, "fluid.grid.x_band with an outlet sponge: the sponge stretches x already; use a "
+           "y_band, or no sponge");
+  if (c.y.band_cells > 0 && c.y.tanh_beta > 0)
+    bad(c, fmt::format("fluid.grid.y_band with fluid.grid.y_stretch = {}: one or the other",
+                       c.y.tanh_beta));
+  if (c.x.band_cells > 0 && px)
+    bad(c, "fluid.grid.x_band stretches x, which is periodic; the fast Poisson solver transforms "
+           "periodic directions, which must be uniform");
+  if (c.y.band_cells > 0 && py)
+    bad(c, "fluid.grid.y_band stretches y, which is periodic; the fast Poisson solver transforms "
+           "periodic directions, which must be uniform");
+  if (c.x.band_cells > 0 && y_stretched)
+    bad(c, "fluid.grid.x_band with a stretched y (y_band or y_stretch): the fast Poisson solver "
+           "needs one uniform direction to transform");
   if (c.x.sponge_cells > 0 && c.bc[right].type != BcType::outflow &&
       c.bc[right].type != BcType::pressure) {
     bad(c, fmt::format("fluid.sponge needs an outflow or a pressure boundary on the right side, got "
                        "fluid.boundary.right = {}",
                        type_name(c.bc[right].type)));
   }
-  if (y_stretched && py) {
+  if (c.y.tanh_beta > 0 && py) {
     bad(c, fmt::format("fluid.grid.y_stretch = {} stretches a periodic direction; the fast Poisson "
                        "solver transforms periodic directions, which must be uniform",
                        c.y.tanh_beta));
   }
-  if (x_stretched && y_stretched) {
-    bad(c, fmt::format("fluid.grid.y_stretch = {} with a stretched outlet sponge in x: the fast "
-                       "Poisson solver needs one uniform direction to transform",
-                       c.y.tanh_beta));
+  if (x_sponge && y_stretched) {
+    bad(c, fmt::format("{} with a stretched outlet sponge in x: the fast Poisson solver needs one "
+                       "uniform direction to transform",
+                       c.y.band_cells > 0 ? std::string("fluid.grid.y_band")
+                                          : fmt::format("fluid.grid.y_stretch = {}", c.y.tanh_beta)));
   }
-  if (x_stretched && px) bad(c, "fluid.sponge: the sponge stretches x, which is periodic");
+  if (x_sponge && px) bad(c, "fluid.sponge: the sponge stretches x, which is periodic");
   if (!(dt > 0)) bad(c, fmt::format("time.dt must be > 0, got {}", dt));
   const double nu = c.viscosity / c.density;
   {
@@ -256,6 +299,18 @@ Config read_config(const fsi::SceneTable& f, double dt) {
   c.x = {int(cells[0]), size[0], origin[0]};
   c.y = {int(cells[1]), size[1], origin[1]};
   c.y.tanh_beta = g.non_negative("y_stretch", 0.0);
+  for (const auto& [a, name] : {std::pair{&c.x, "x_band"}, std::pair{&c.y, "y_band"}}) {
+    const auto band = g.optional_table(name);
+    if (!band) continue;
+    a->band_from = band->number("from");
+    a->band_to = band->number("to");
+    const double cells_in = band->positive_integer("cells");
+    if (cells_in > a->cells)
+      band->fail("cells", fmt::format("= {:g} is more than the direction's {} cells "
+                                      "(fluid.grid.cells)", cells_in, a->cells));
+    a->band_cells = int(cells_in);
+    band->finish();
+  }
   g.finish();
 
   const fsi::SceneTable b = f.table("boundary");

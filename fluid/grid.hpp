@@ -1,6 +1,7 @@
 // The fluid's fixed Cartesian grid: cell faces and centres along x and y, each direction uniform,
-// tanh-clustered towards both ends (y), or uniform with a geometrically stretched outlet sponge
-// appended at x = x_max. Holds the precomputed inverse spacings and interpolation weights that the
+// tanh-clustered towards both ends (y), uniform in a band with cells growing geometrically away
+// from it (either direction), or uniform with a geometrically stretched outlet sponge appended at
+// x = x_max. Holds the precomputed inverse spacings and interpolation weights that the
 // staggered (MAC) stencils use, ghost cells included.
 #pragma once
 
@@ -17,7 +18,25 @@ struct AxisSpec {
   double tanh_beta = 0;      // > 0: faces clustered towards both ends, x = L/2 (1 + tanh(b s)/tanh(b))
   int sponge_cells = 0;      // extra cells appended beyond origin + length ...
   double sponge_ratio = 1;   // ... each this much wider than the previous one
+  int band_cells = 0;        // > 0: this many of `cells` evenly over [band_from, band_to], the
+  double band_from = 0;      //   others outside it, growing geometrically away from it
+  double band_to = 0;
 };
+
+// How the cells outside a band are laid out: `below` cells between origin and band_from and
+// `above` between band_to and the far end, each `growth_*` times as wide as its neighbour on the
+// band's side (the first one growth times the band's spacing), so that every width varies
+// smoothly. The split of the outside cells is the one with the smallest largest growth. A growth
+// below 1 (outside cells narrower than the band's) is reported as it is.
+struct BandLayout {
+  int below = 0, above = 0;
+  double growth_below = 1, growth_above = 1;
+  // The largest of the growths and their inverses: how abruptly the widths change.
+  double worst() const;
+};
+// Throws fsi::Error when the band does not fit (outside [origin, origin + length], no cells
+// left for a side with room, or more band cells than cells).
+BandLayout band_layout(const AxisSpec& s);
 
 // One direction. Index conventions: cells 0..n-1, faces 0..n (face i is the low side of cell i).
 // Stencil arrays also cover one ghost cell on each side: widths w(i) for i in [-1, n], ghost

@@ -22,6 +22,8 @@ rho_s = 10 rho_f (only the transient differs).
   validate --dt-limit FSI2 on L2 at growing dt: the largest stable step
   validate --fsi1-level L4   FSI1 on another level (default L2); --fsi1-only: FSI1 alone
   validate --fsi1-grids FSI1 on four fluid grids with one bar mesh, to t = 8 (about 15 min)
+  validate --fsi1-bands FSI1 on 500 columns with the rows in a y band around the body (82, 123,
+                      164 rows), to t = 8 (about 8 min)
   validate --reuse    keep a run whose folder has a summary.json from the identical scene text
 Environment (set by ./fsi validate): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN."""
 import json
@@ -49,6 +51,7 @@ _p.add_argument("--dt-limit", action="store_true", help="FSI2 on L2 at growing d
 _p.add_argument("--fsi1-level", default="L2", help="FSI1's level (L2)")
 _p.add_argument("--fsi1-only", action="store_true", help="FSI1 alone")
 _p.add_argument("--fsi1-grids", action="store_true", help="FSI1 on four fluid grids")
+_p.add_argument("--fsi1-bands", action="store_true", help="FSI1 on grids with a y band")
 _p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
 ARGS = _p.parse_args()
 # --ci: L2 only, the frequency judged against the refined values and reported against the 2006
@@ -105,13 +108,17 @@ TOL = {"amplitude": 0.05, "frequency": 0.03}
 def scene_text(case, level, dt=None, rho_s=None, t_end=None):
     lv = LEVELS[level]
     n = lv["n"]
-    h = H / n
+    # A level with a y band keeps the columns (and the cylinder's mesh) of its `nx_rows` uniform
+    # rows and lays its n rows out with the band (fluid/README.md, fluid.grid.y_band).
+    h = H / lv.get("nx_rows", n)
     nx = int(round(L / h))
     dt = lv["dt"] if dt is None else dt
     t_end = T_END if t_end is None else t_end
     replace = {
         "name": f'name = "{case}-{level}"',
-        "cells": f"cells = [{nx}, {n}]",
+        "cells": f"cells = [{nx}, {n}]" + (
+            "\ny_band = {{ from = {:g}, to = {:g}, cells = {} }}".format(*lv["band"])
+            if "band" in lv else ""),
         "dt": f"dt = {dt:.10g}",
         "t_end": f"t_end = {t_end:g}",
         "mesh_parameters": f'mesh_parameters = "lc = {h:.10g}"',
@@ -387,6 +394,38 @@ def fsi1_grids():
     fig.savefig(os.path.join(OUT, "fsi1_grids.png"), dpi=120)
 
 
+def fsi1_bands():
+    """FSI1 (rho_s = 10 rho_f, t = 8, as --fsi1-grids) on 500 columns with the rows clustered in a
+    y band around the cylinder and the bar: the same cells as 500 x 82 with the bar 10 cells thick
+    instead of 4, and two larger ones; against the uniform grids of --fsi1-grids (README)."""
+    rows = []
+    # dt 5e-4 as on the uniform grids; 2.5e-4 on 164 rows, below the explicit diffusion limit
+    # (3.4e-4 with the band's 1.2 mm rows).
+    for n, band, dt in [(82, (0.16, 0.24, 40), 5e-4), (123, (0.14, 0.26, 72), 5e-4),
+                        (164, (0.14, 0.26, 100), 2.5e-4)]:
+        level = f"B{n}"
+        LEVELS[level] = {"n": n, "nx_rows": 82, "dt": dt, "bar": [140, 8], "band": band}
+        folder, wall, _ = run(f"fsi1-band-{n}", scene_text("fsi1", level, rho_s=10000.0, t_end=8.0))
+        hist = histories(folder)
+        hy = (band[1] - band[0]) / band[2]
+        r = {"rows": n, "columns": 500, "band": band, "h_band": hy, "bar_cells_across": 0.02 / hy,
+             "dt": dt, "wall_s": wall}
+        for q in ("ux", "uy", "drag", "lift"):
+            t, y = hist[q]
+            last = float(y[-1])
+            ref = REF[("fsi1", q)]["mean"]
+            r[q] = {"value": last, "reference": ref, "error": last / ref - 1.0,
+                    "change_over_last_0.5_s": last - float(np.interp(t[-1] - 0.5, t, y))}
+        rows.append(r)
+        print(f"FSI1 on 500 x {n}, band [{band[0]}, {band[1]}] x {band[2]} (bar {0.02 / hy:.0f} "
+              f"cells thick): u_y(A) {1e3 * r['uy']['value']:.4f} mm ({100 * r['uy']['error']:+.1f} %), "
+              f"u_x(A) {100 * r['ux']['error']:+.1f} %, lift {r['lift']['value']:.4f} "
+              f"({100 * r['lift']['error']:+.1f} %), drag {r['drag']['value']:.3f} "
+              f"({100 * r['drag']['error']:+.1f} %), {wall:.0f} s", flush=True)
+    with open(os.path.join(OUT, "fsi1_bands.json"), "w") as f:
+        json.dump(rows, f, indent=2)
+
+
 def write_levels(rows):
     with open(os.path.join(OUT, "levels-coarse.md" if COARSE else "levels.md"), "w") as f:
         f.write("Errors against Turek & Hron (2006); in brackets against the refined FEATFLOW values "
@@ -419,6 +458,9 @@ def main():
         return
     if ARGS.fsi1_grids:
         fsi1_grids()
+        return
+    if ARGS.fsi1_bands:
+        fsi1_bands()
         return
     metrics, rows, extra = {}, [], {}
     if not ARGS.fsi1_only:

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "config.hpp"
+#include "grid.hpp"
 #include "error.hpp"
 #include "scene.hpp"
 
@@ -130,4 +131,58 @@ TEST_CASE("pressure boundaries: where they are allowed", "[fluid][config][pressu
   CHECK_THROWS_WITH(read(replace(open, "right = { type = \"pressure\" }",
                                  "right = { type = \"pressure\", entering = \"dynamic\" }")),
                     Contains("entering"));
+}
+
+TEST_CASE("a band of even cells with smooth growth outside it", "[fluid][config][band]") {
+  const std::string walls = replace(replace(kGood, "left = { type = \"periodic\" }", "left = { type = \"wall\" }"),
+                                    "right = { type = \"periodic\" }", "right = { type = \"wall\" }");
+  const fluid::Config c = read(replace(walls, "size = [2.0, 1.0]",
+                                       "size = [2.0, 1.0]\ny_band = { from = 0.4, to = 0.6, cells = 4 }"));
+  REQUIRE(c.y.band_cells == 4);
+  const fluid::Axis y(c.y);
+  CHECK_FALSE(y.uniform());
+  CHECK(y.lo() == 0.0);
+  CHECK(y.hi() == 1.0);
+  const fluid::BandLayout l = fluid::band_layout(c.y);
+  CHECK(l.below + l.above == 12);
+  CHECK(l.below == 6);  // the band sits in the middle: the split is symmetric
+  // Even in the band, its edges on faces; outside, each cell wider than the one nearer the band
+  // by the same ratio, the first by that ratio over the band's spacing.
+  CHECK(y.face(l.below) == 0.4);
+  CHECK(y.face(l.below + 4) == 0.6);
+  for (int j = l.below; j < l.below + 4; ++j) CHECK(y.width(j) == Approx(0.05).epsilon(1e-12));
+  for (int j = 0; j < l.below; ++j)
+    CHECK(y.width(j) / y.width(j + 1) == Approx(l.growth_below).epsilon(1e-9));
+  for (int j = l.below + 4; j < 16; ++j)
+    CHECK(y.width(j) / y.width(j - 1) == Approx(l.growth_above).epsilon(1e-9));
+  CHECK(l.worst() <= 1.2);
+  CHECK(l.growth_below > 1.0);
+
+  // The same band in x (the transform then runs along y, which must stay uniform).
+  const fluid::Config cx = read(replace(walls, "size = [2.0, 1.0]",
+                                        "size = [2.0, 1.0]\nx_band = { from = 0.5, to = 1.0, cells = 8 }"));
+  const fluid::Axis x(cx.x);
+  CHECK_FALSE(x.uniform());
+  CHECK(x.hi() == 2.0);
+}
+
+TEST_CASE("bands that cannot be laid out are refused with the key", "[fluid][config][band]") {
+  const std::string walls = replace(replace(kGood, "left = { type = \"periodic\" }", "left = { type = \"wall\" }"),
+                                    "right = { type = \"periodic\" }", "right = { type = \"wall\" }");
+  auto with = [&](const std::string& keys) { return read(replace(walls, "size = [2.0, 1.0]", "size = [2.0, 1.0]\n" + keys)); };
+  CHECK_THROWS_WITH(with("y_band = { from = 0.4, to = 1.2, cells = 8 }"),
+                    Contains("fluid.grid.y_band") && Contains("within [0, 1]"));
+  CHECK_THROWS_WITH(with("y_band = { from = 0.45, to = 0.55, cells = 14 }"),
+                    Contains("fluid.grid.y_band") && Contains("change width by a factor") &&
+                        Contains("fluid_config_test.toml"));
+  CHECK_THROWS_WITH(with("y_band = { from = 0.4, to = 0.6, cells = 20 }"),
+                    Contains("cells") && Contains("more than the direction's 16 cells"));
+  CHECK_THROWS_WITH(with("y_band = { from = 0.4, to = 0.6, cells = 4 }\ny_stretch = 1.2"),
+                    Contains("fluid.grid.y_band with fluid.grid.y_stretch"));
+  CHECK_THROWS_WITH(with("y_band = { from = 0.4, to = 0.6, cells = 4 }\nx_band = { from = 0.5, to = 1.0, cells = 8 }"),
+                    Contains("fluid.grid.x_band with a stretched y"));
+  CHECK_THROWS_WITH(with("y_band = { from = 0.4, to = 0.6, cells = 8, step = 2 }"), Contains("step"));
+  // A band along a periodic direction.
+  CHECK_THROWS_WITH(read(replace(kGood, "size = [2.0, 1.0]", "size = [2.0, 1.0]\nx_band = { from = 0.5, to = 1.0, cells = 8 }")),
+                    Contains("fluid.grid.x_band stretches x, which is periodic"));
 }
