@@ -351,6 +351,18 @@ def dt_limit():
         json.dump(rows, f, indent=2)
 
 
+def steady_values(hist):
+    """FSI1's last values against the benchmark, with their change over the last 0.5 s."""
+    out = {}
+    for q in ("ux", "uy", "drag", "lift"):
+        t, y = hist[q]
+        last = float(y[-1])
+        ref = REF[("fsi1", q)]["mean"]
+        out[q] = {"value": last, "reference": ref, "error": last / ref - 1.0,
+                  "change_over_last_0.5_s": last - float(np.interp(t[-1] - 0.5, t, y))}
+    return out
+
+
 def fsi1_grids():
     """FSI1 (rho_s = 10 rho_f) on 82, 123, 164 and 246 rows with the same bar mesh (140 x 8): the
     fluid grid changes, and with it lambda = nu dt / h^2 (0.02 ... 0.09). The tip deflection is
@@ -366,12 +378,7 @@ def fsi1_grids():
         hist = histories(folder)
         r = {"rows": n, "h": H / n, "dt": LEVELS[level]["dt"],
              "lambda": 1e-3 * LEVELS[level]["dt"] / (H / n) ** 2, "wall_s": wall}
-        for q in ("ux", "uy", "drag", "lift"):
-            t, y = hist[q]
-            last = float(y[-1])
-            ref = REF[("fsi1", q)]["mean"]
-            r[q] = {"value": last, "reference": ref, "error": last / ref - 1.0,
-                    "change_over_last_0.5_s": last - float(np.interp(t[-1] - 0.5, t, y))}
+        r.update(steady_values(hist))
         r["tip_deflection_in_cells"] = r["uy"]["value"] / r["h"]
         rows.append(r)
         print(f"FSI1 on {n} rows: u_y(A) {1e3 * r['uy']['value']:.4f} mm "
@@ -410,12 +417,7 @@ def fsi1_bands():
         hy = (band[1] - band[0]) / band[2]
         r = {"rows": n, "columns": 500, "band": band, "h_band": hy, "bar_cells_across": 0.02 / hy,
              "dt": dt, "wall_s": wall}
-        for q in ("ux", "uy", "drag", "lift"):
-            t, y = hist[q]
-            last = float(y[-1])
-            ref = REF[("fsi1", q)]["mean"]
-            r[q] = {"value": last, "reference": ref, "error": last / ref - 1.0,
-                    "change_over_last_0.5_s": last - float(np.interp(t[-1] - 0.5, t, y))}
+        r.update(steady_values(hist))
         rows.append(r)
         print(f"FSI1 on 500 x {n}, band [{band[0]}, {band[1]}] x {band[2]} (bar {0.02 / hy:.0f} "
               f"cells thick): u_y(A) {1e3 * r['uy']['value']:.4f} mm ({100 * r['uy']['error']:+.1f} %), "
