@@ -337,8 +337,7 @@ std::filesystem::path choose_out_dir(const std::filesystem::path& root, const st
 
 void Link::send_bytes(std::size_t size, proto::Tag tag) {
   MPI_Request req;
-  MPI_Isend(m_out.data(), static_cast<int>(size), MPI_BYTE, 0, static_cast<int>(tag), m_comm,
-            &req);
+  MPI_Isend(m_out.data(), static_cast<int>(size), MPI_BYTE, 0, static_cast<int>(tag), m_comm, &req);
   wait_until(
       [&] {
         int done = 0;

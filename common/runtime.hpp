@@ -99,7 +99,8 @@ class Link {
   Role m_peer;
   std::uint64_t m_sent = 0, m_received = 0;
   // Kept between messages (see proto::Writer): a send completes before send() returns, and a
-  // received message is unpacked before the next is received.
+  // received message is unpacked before the next is received. Each keeps the size of the
+  // largest message so far (up to twice that after a growth), set-up messages included.
   std::vector<std::byte> m_out, m_in;
 };
 

@@ -217,17 +217,24 @@ int main(int argc, char** argv) {
               "CPU with the cylinder 2.25-2.56 -> 2.18-2.22 ms, bar alone unchanged (1.98-2.12 "
               "against 1.92-2.15; the cylinder's share 0.14-0.49 -> 0.03-0.30 ms; three "
               "interleaved pairs, machine loaded); results identical to the bit\n");
-  const double slow = fiber_coupling_us(0.002, 20 * steps), fast = fiber_coupling_us(0.02, 20 * steps);
-  std::printf("fiber coupling, 16 fibers x 63 markers on 128 x 96 (glycocalyx), CPU per step:\n"
-              "  slow sway (markers keep their cells) %.1f us, fast sway %.1f us\n", slow, fast);
+  const double slow = fiber_coupling_us(0.002, 20 * steps),
+               fast = fiber_coupling_us(0.02, 20 * steps);
+  std::printf(
+      "fiber coupling, 16 fibers x 63 markers on 128 x 96 (glycocalyx), CPU per step:\n"
+      "  slow sway (markers keep their cells) %.1f us, fast sway %.1f us\n",
+      slow, fast);
   std::printf("notes: change | predicted | measured (this bench's slow sway, best of 6 runs)\n");
-  std::printf("  face indices wrapped once per kernel row instead of two integer divisions per "
-              "face; spread() without marks, its faces read off the stencil; the stencil kept while no marker changes cell | -50 %% | 270 -> "
-              "117 us\n");
-  std::printf("  floor without a libm call, sqrt as one instruction (-fno-math-errno) | -10 %% | "
-              "116 -> 102 us\n");
-  std::printf("  faces beyond a wall in one extra slot, so interpolation and spreading run without "
-              "a branch per face; row offsets once per kernel row | -10 %% | 102 -> 98 us\n");
+  std::printf(
+      "  face indices wrapped once per kernel row instead of two integer divisions per "
+      "face; spread() without marks, its faces read off the stencil; the stencil kept while no "
+      "marker changes cell | -50 %% | 270 -> "
+      "117 us\n");
+  std::printf(
+      "  floor without a libm call, sqrt as one instruction (-fno-math-errno) | -10 %% | "
+      "116 -> 102 us\n");
+  std::printf(
+      "  faces beyond a wall in one extra slot, so interpolation and spreading run without "
+      "a branch per face; row offsets once per kernel row | -10 %% | 102 -> 98 us\n");
   if (out) {
     if (FILE* f = std::fopen(out, "w")) {
       auto fields = [&](const Result& r) {

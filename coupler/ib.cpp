@@ -43,6 +43,20 @@ bool uniform(const std::vector<double>& f, double& h) {
     if (std::abs(f[i + 1] - f[i] - h) > kUniform * h) return false;
   return true;
 }
+
+// The `width` face indices from i0 along a direction of n faces: wrapped once and then stepped
+// (an integer division per face would cost more than the kernel's arithmetic), or −1 outside a
+// bounded direction.
+void face_run(int i0, int n, bool periodic, int width, int* out) {
+  if (periodic) {
+    int i = i0 % n;
+    if (i < 0) i += n;
+    for (int k = 0; k < width; ++k, i = i + 1 == n ? 0 : i + 1) out[k] = i;
+  } else {
+    for (int k = 0; k < width; ++k) out[k] = (i0 + k < 0 || i0 + k >= n) ? -1 : i0 + k;
+  }
+}
+
 }  // namespace
 
 FeedbackIB::FeedbackIB(const proto::GridInfo& g) {
@@ -60,20 +74,9 @@ FeedbackIB::FeedbackIB(const proto::GridInfo& g) {
     f->px = g.periodic_x != 0, f->py = g.periodic_y != 0;
     // One slot past the faces: `outside` (see Family).
     const std::size_t n = static_cast<std::size_t>(f->ni) * f->nj + 1;
-    f->value.assign(n, 0.0), f->has_value.assign(n, 1), f->force.assign(n, 0.0), f->mark.assign(n, 0);
-  }
-}
-
-// The four face indices from i0 along a direction of n faces: wrapped once and then stepped
-// (an integer division per face would cost more than the kernel's arithmetic), or −1 outside a
-// bounded direction.
-static void face_run(int i0, int n, bool periodic, int out[4]) {
-  if (periodic) {
-    int i = i0 % n;
-    if (i < 0) i += n;
-    for (int k = 0; k < 4; ++k, i = i + 1 == n ? 0 : i + 1) out[k] = i;
-  } else {
-    for (int k = 0; k < 4; ++k) out[k] = (i0 + k < 0 || i0 + k >= n) ? -1 : i0 + k;
+    f->value.assign(n, 0.0), f->has_value.assign(n, 0), f->force.assign(n, 0.0);
+    f->mark.assign(n, 0);
+    f->has_value.back() = 1;
   }
 }
 
@@ -84,8 +87,8 @@ void FeedbackIB::kernel(const Family& f, double X, double Y, std::int32_t idx[16
   int ii[4], jj[4];
   peskin4_weights(sx - (i0 + 1), wx);
   peskin4_weights(sy - (j0 + 1), wy);
-  face_run(i0, f.ni, f.px, ii);
-  face_run(j0, f.nj, f.py, jj);
+  face_run(i0, f.ni, f.px, 4, ii);
+  face_run(j0, f.nj, f.py, 4, jj);
   const std::int32_t outside = f.ni * f.nj;
   for (int b = 0; b < 4; ++b) {
     const std::int32_t row = jj[b] < 0 ? -1 : f.ni * jj[b];
@@ -103,15 +106,6 @@ void FeedbackIB::stencil(const std::vector<std::vector<double>>& markers, int ma
                          std::vector<std::int32_t>& u_faces, std::vector<std::int32_t>& v_faces) {
   const int width = 4 + 2 * margin;
   std::vector<int> cols(static_cast<std::size_t>(width)), rows(static_cast<std::size_t>(width));
-  // Indices of `width` faces from k0 along a direction of n faces, wrapped once and stepped.
-  auto run = [width](int k0, int n, bool periodic, std::vector<int>& out) {
-    int k = k0;
-    if (periodic) k = ((k % n) + n) % n;
-    for (int c = 0; c < width; ++c, ++k) {
-      if (periodic && k == n) k = 0;
-      out[c] = (k < 0 || k >= n) ? -1 : k;
-    }
-  };
   for (auto [f, out] : {std::pair{&m_u, &u_faces}, std::pair{&m_v, &v_faces}}) {
     // The windows' lower-left cells, one per run of markers in the same cell. Markers move far
     // less than a cell per step, so most steps find the windows, and so the faces, of the last
@@ -120,8 +114,12 @@ void FeedbackIB::stencil(const std::vector<std::vector<double>>& markers, int ma
     cells.clear();
     for (const auto& x : markers) {
       for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
-        const int ic = floor_int((x[m] - f->x0) / m_hx);
-        const int jc = floor_int((x[m + 1] - f->y0) / m_hy);
+        const double sx = (x[m] - f->x0) / m_hx, sy = (x[m + 1] - f->y0) / m_hy;
+        // floor_int needs int's range; a marker this far off is lost anyway.
+        if (!(std::abs(sx) < kFarCells && std::abs(sy) < kFarCells))
+          fsi::fail("fiber marker at ({}, {}) is not finite or far outside the fluid grid", x[m],
+                    x[m + 1]);
+        const int ic = floor_int(sx), jc = floor_int(sy);
         const std::size_t n = cells.size();
         if (m > 0 && cells[n - 2] == ic && cells[n - 1] == jc) continue;
         cells.push_back(ic), cells.push_back(jc);
@@ -137,8 +135,8 @@ void FeedbackIB::stencil(const std::vector<std::vector<double>>& markers, int ma
     for (std::size_t w = 0; w < cells.size(); w += 2) {
       const int ic = cells[w], jc = cells[w + 1];
       if (ic == kFiberEnd) continue;
-      run(ic - 1 - margin, f->ni, f->px, cols);
-      run(jc - 1 - margin, f->nj, f->py, rows);
+      face_run(ic - 1 - margin, f->ni, f->px, width, cols.data());
+      face_run(jc - 1 - margin, f->nj, f->py, width, rows.data());
       for (const int b : rows) {
         if (b < 0) continue;
         for (const int a : cols) {
@@ -176,10 +174,15 @@ void FeedbackIB::kernels(const std::vector<double>& x) const {
   if (x == m_kernel_x) return;
   const std::size_t markers = x.size() / 2;
   m_idx.resize(32 * markers), m_w.resize(32 * markers);
-  for (std::size_t m = 0; m < markers; ++m)
+  for (std::size_t m = 0; m < markers; ++m) {
+    if (!(std::abs(x[2 * m] - m_u.x0) < kFarCells * m_hx &&
+          std::abs(x[2 * m + 1] - m_v.y0) < kFarCells * m_hy))
+      fsi::fail("fiber marker at ({}, {}) is not finite or far outside the fluid grid", x[2 * m],
+                x[2 * m + 1]);
     for (int c = 0; c < 2; ++c)
       kernel(c == 0 ? m_u : m_v, x[2 * m], x[2 * m + 1], &m_idx[32 * m + 16 * c],
              &m_w[32 * m + 16 * c]);
+  }
   m_kernel_x = x;
 }
 
@@ -198,9 +201,10 @@ void FeedbackIB::interpolate(const std::vector<double>& x, std::vector<double>& 
         s += w[k] * f.value[idx[k]];
       }
       if (!sampled)
-        fsi::fail("fiber marker at ({}, {}) moved beyond the sampled stencil in one step "
-                  "(more than a grid cell): reduce dt",
-                  x[m], x[m + 1]);
+        fsi::fail(
+            "fiber marker at ({}, {}) moved beyond the sampled stencil in one step "
+            "(more than a grid cell): reduce dt",
+            x[m], x[m + 1]);
       u[m + c] = s;
     }
   }
@@ -237,6 +241,10 @@ void FeedbackIB::take_spread(const std::vector<std::int32_t>& u_faces,
       out->force.push_back(f->force[k]);
       f->force[k] = 0;
     }
+#ifndef NDEBUG
+    // Every face spread to was in the list (the stencil of the spread markers): none kept a force.
+    for (std::size_t k = 0; k + 1 < f->force.size(); ++k) FSI_ASSERT(f->force[k] == 0);
+#endif
   }
 }
 

@@ -56,8 +56,9 @@ class FeedbackIB {
   // The accumulated spread force as sparse face lists (sorted), then cleared. u_faces, v_faces:
   // a stencil() (any margin) of every marker spread since the last take: it holds every face
   // they touched.
-  void take_spread(const std::vector<std::int32_t>& u_faces, const std::vector<std::int32_t>& v_faces,
-                   proto::FaceForce& u, proto::FaceForce& v);
+  void take_spread(const std::vector<std::int32_t>& u_faces,
+                   const std::vector<std::int32_t>& v_faces, proto::FaceForce& u,
+                   proto::FaceForce& v);
 
   double hx() const { return m_hx; }
   double hy() const { return m_hy; }
@@ -72,16 +73,18 @@ class FeedbackIB {
     // spreading run without a branch per face.
     std::vector<double> value;   // sampled velocity per face
     std::vector<char> has_value;
-    std::vector<double> force;   // spread force per face, until take_spread()
-    std::vector<char> mark;      // face listed (within stencil() only)
+    std::vector<double> force;  // spread force per face, until take_spread()
+    std::vector<char> mark;     // face listed (within stencil() only)
     // The last stencil(): its windows' cells (i, j per window, kFiberEnd twice after each
     // fiber), margin and faces; and the scratch for the next call's cells.
     std::vector<int> windows, window_scratch;
     int window_margin = -1;
     std::vector<std::int32_t> window_faces;
   };
-  // Marks the end of a fiber in Family::windows (no cell index is this low).
+  // Marks the end of a fiber in Family::windows: no cell index is this low (stencil() refuses a
+  // marker more than kFarCells cells from the grid's origin).
   static constexpr int kFiberEnd = std::numeric_limits<int>::min();
+  static constexpr double kFarCells = 1e9;
   // The 4 × 4 kernel of point (X, Y) on a family: face indices (`outside` beyond a bounded
   // side) and weights φ φ.
   void kernel(const Family& f, double X, double Y, std::int32_t idx[16], double w[16]) const;

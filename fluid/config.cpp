@@ -129,26 +129,32 @@ void validate(const Config& c, double dt) {
     }
     if (l.worst() > kMaxBandGrowth)
       bad(c, fmt::format("fluid.grid.{} = {{ from = {:g}, to = {:g}, cells = {} }}: the {} cells "
-                         "outside it would change width by a factor {:.3g} from cell to cell (at "
+                         "outside it would change width by a factor {} from cell to cell (at "
                          "most {:g}); give the direction more cells, the band fewer, or widen it",
                          name, a->band_from, a->band_to, a->band_cells, a->cells - a->band_cells,
-                         l.worst(), kMaxBandGrowth));
+                         std::isfinite(l.worst()) ? fmt::format("{:.3g}", l.worst())
+                                                  : std::string("of more than 10"),
+                         kMaxBandGrowth));
   }
   if (c.x.band_cells > 0 && x_sponge)
-    bad(c, "fluid.grid.x_band with an outlet sponge: the sponge stretches x already; use a "
-           "y_band, or no sponge");
+    bad(c,
+        "fluid.grid.x_band with an outlet sponge: the sponge stretches x already; use a "
+        "y_band, or no sponge");
   if (c.y.band_cells > 0 && c.y.tanh_beta > 0)
     bad(c, fmt::format("fluid.grid.y_band with fluid.grid.y_stretch = {}: one or the other",
                        c.y.tanh_beta));
   if (c.x.band_cells > 0 && px)
-    bad(c, "fluid.grid.x_band stretches x, which is periodic; the fast Poisson solver transforms "
-           "periodic directions, which must be uniform");
+    bad(c,
+        "fluid.grid.x_band stretches x, which is periodic; the fast Poisson solver transforms "
+        "periodic directions, which must be uniform");
   if (c.y.band_cells > 0 && py)
-    bad(c, "fluid.grid.y_band stretches y, which is periodic; the fast Poisson solver transforms "
-           "periodic directions, which must be uniform");
+    bad(c,
+        "fluid.grid.y_band stretches y, which is periodic; the fast Poisson solver transforms "
+        "periodic directions, which must be uniform");
   if (c.x.band_cells > 0 && y_stretched)
-    bad(c, "fluid.grid.x_band with a stretched y (y_band or y_stretch): the fast Poisson solver "
-           "needs one uniform direction to transform");
+    bad(c,
+        "fluid.grid.x_band with a stretched y (y_band or y_stretch): the fast Poisson solver "
+        "needs one uniform direction to transform");
   if (c.x.sponge_cells > 0 && c.bc[right].type != BcType::outflow &&
       c.bc[right].type != BcType::pressure) {
     bad(c, fmt::format("fluid.sponge needs an outflow or a pressure boundary on the right side, got "
@@ -161,10 +167,11 @@ void validate(const Config& c, double dt) {
                        c.y.tanh_beta));
   }
   if (x_sponge && y_stretched) {
-    bad(c, fmt::format("{} with a stretched outlet sponge in x: the fast Poisson solver needs one "
-                       "uniform direction to transform",
-                       c.y.band_cells > 0 ? std::string("fluid.grid.y_band")
-                                          : fmt::format("fluid.grid.y_stretch = {}", c.y.tanh_beta)));
+    bad(c,
+        fmt::format("{} with a stretched outlet sponge in x: the fast Poisson solver needs one "
+                    "uniform direction to transform",
+                    c.y.band_cells > 0 ? std::string("fluid.grid.y_band")
+                                       : fmt::format("fluid.grid.y_stretch = {}", c.y.tanh_beta)));
   }
   if (x_sponge && px) bad(c, "fluid.sponge: the sponge stretches x, which is periodic");
   if (!(dt > 0)) bad(c, fmt::format("time.dt must be > 0, got {}", dt));
@@ -304,10 +311,11 @@ Config read_config(const fsi::SceneTable& f, double dt) {
     if (!band) continue;
     a->band_from = band->number("from");
     a->band_to = band->number("to");
-    const double cells_in = band->positive_integer("cells");
+    const long cells_in = band->positive_integer("cells");
     if (cells_in > a->cells)
-      band->fail("cells", fmt::format("= {:g} is more than the direction's {} cells "
-                                      "(fluid.grid.cells)", cells_in, a->cells));
+      band->fail("cells", fmt::format("= {} is more than the direction's {} cells "
+                                      "(fluid.grid.cells)",
+                                      cells_in, a->cells));
     a->band_cells = int(cells_in);
     band->finish();
   }

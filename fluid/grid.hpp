@@ -29,13 +29,15 @@ struct AxisSpec {
 // smoothly. The split of the outside cells is the one with the smallest largest growth. A growth
 // below 1 (outside cells narrower than the band's) is reported as it is.
 struct BandLayout {
+  double from = 0, to = 0;  // the band's edges (an edge within round-off of an end: that end)
   int below = 0, above = 0;
   double growth_below = 1, growth_above = 1;
   // The largest of the growths and their inverses: how abruptly the widths change.
   double worst() const;
 };
 // Throws fsi::Error when the band does not fit (outside [origin, origin + length], no cells
-// left for a side with room, or more band cells than cells).
+// left for a side with room, more band cells than cells, or a band over the whole direction
+// with fewer cells than the direction's).
 BandLayout band_layout(const AxisSpec& s);
 
 // One direction. Index conventions: cells 0..n-1, faces 0..n (face i is the low side of cell i).

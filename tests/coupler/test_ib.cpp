@@ -150,3 +150,91 @@ TEST_CASE("a stretched grid is refused for fibers") {
   g.y_face[3] += 0.01;
   CHECK_THROWS_WITH(FeedbackIB(g), Catch::Contains("fibers need a uniform fluid grid"));
 }
+
+// Near a bounded side the kernel reaches faces beyond the wall, which hold no velocity and take
+// no force: interpolation is the sum over the faces inside, spreading drops the rest, and the two
+// stay each other's transpose.
+TEST_CASE("next to a wall: interpolation over the faces inside, spreading its transpose") {
+  const auto g = grid(32, 20, 1.6, 1.0, false, false);  // h = 0.05, walls all round
+  FeedbackIB ib(g);
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> r(-1, 1);
+  std::vector<double> x, F;  // within a cell and a half of the bottom and left walls
+  for (int m = 0; m < 30; ++m) {
+    x.push_back(0.01 + 0.002 * m), x.push_back(0.012 + 0.002 * m);
+    F.push_back(r(rng)), F.push_back(r(rng));
+  }
+  std::vector<std::int32_t> su, sv;
+  ib.stencil({x}, 1, su, sv);
+  std::vector<double> u(su.size()), v(sv.size());
+  for (auto& a : u) a = r(rng);
+  for (auto& a : v) a = r(rng);
+  ib.store_samples(su, u, sv, v);
+  std::vector<double> U;
+  ib.interpolate(x, U);
+  // The same sum written out with the kernel over the faces inside the grid.
+  for (std::size_t m = 0; m < x.size(); m += 2)
+    for (int c = 0; c < 2; ++c) {
+      const auto& faces = c == 0 ? su : sv;
+      const auto& val = c == 0 ? u : v;
+      double s = 0;
+      for (std::size_t k = 0; k < faces.size(); ++k) {
+        double fx = 0, fy = 0;
+        face_xy(g, c, faces[k], fx, fy);
+        s += val[k] * peskin4((fx - x[m]) / 0.05) * peskin4((fy - x[m + 1]) / 0.05);
+      }
+      CHECK(U[m + c] == Approx(s).margin(1e-13));
+    }
+  const double ds = 0.002;
+  ib.spread(x, F, ds);
+  proto::FaceForce fu, fv;
+  ib.take_spread(su, sv, fu, fv);
+  const double cell = ib.hx() * ib.hy();
+  auto w = [&](std::size_t m) { return m / 2 == 0 || m / 2 == F.size() / 2 - 1 ? 0.5 * ds : ds; };
+  double grid_side = 0, marker_side = 0;
+  for (std::size_t k = 0; k < fu.index.size(); ++k)
+    grid_side += fu.force[k] * cell * u[std::lower_bound(su.begin(), su.end(), fu.index[k]) - su.begin()];
+  for (std::size_t k = 0; k < fv.index.size(); ++k)
+    grid_side += fv.force[k] * cell * v[std::lower_bound(sv.begin(), sv.end(), fv.index[k]) - sv.begin()];
+  for (std::size_t m = 0; m < F.size(); ++m) marker_side += F[m] * U[m] * w(m);
+  CHECK(std::abs(grid_side + marker_side) <= 1e-12 * std::abs(marker_side));
+  // The next take finds nothing left over.
+  ib.take_spread(su, sv, fu, fv);
+  CHECK(fu.index.empty());
+  CHECK(fv.index.empty());
+}
+
+// The stencil is kept while every marker stays in its cell; it must equal a fresh one's after a
+// sub-cell move, after a marker crosses into another cell, and with another margin or fiber count.
+TEST_CASE("the kept sample stencil equals a fresh one") {
+  const auto g = grid(48, 40, 1.2, 1.0, true, false);
+  FeedbackIB kept(g);
+  std::vector<std::vector<double>> fibers(3);
+  auto place = [&](double shift) {
+    for (int k = 0; k < 3; ++k) {
+      fibers[k].clear();
+      for (int m = 0; m < 20; ++m)
+        fibers[k].push_back(std::fmod(0.1 + 0.4 * k + shift + 0.001 * m + 1.2, 1.2)),
+            fibers[k].push_back(0.3 + 0.008 * m);
+    }
+  };
+  auto same_as_fresh = [&](int margin) {
+    std::vector<std::int32_t> ku, kv, fu, fv;
+    kept.stencil(fibers, margin, ku, kv);
+    FeedbackIB fresh(g);
+    fresh.stencil(fibers, margin, fu, fv);
+    CHECK(ku == fu);
+    CHECK(kv == fv);
+  };
+  place(0.0);
+  same_as_fresh(1);
+  place(1e-4);  // within the cells
+  same_as_fresh(1);
+  place(0.013);  // about half a cell: some markers change cell
+  same_as_fresh(1);
+  same_as_fresh(0);
+  fibers.pop_back();
+  same_as_fresh(0);
+  place(-0.2);  // across the periodic side
+  same_as_fresh(1);
+}

@@ -1,12 +1,11 @@
 // Bad input in the [fluid] table: each error names the key, the value and the file.
 #include <catch2/catch.hpp>
-
 #include <fstream>
 #include <string>
 
 #include "config.hpp"
-#include "grid.hpp"
 #include "error.hpp"
+#include "grid.hpp"
 #include "scene.hpp"
 
 using Catch::Matchers::Contains;
@@ -134,10 +133,12 @@ TEST_CASE("pressure boundaries: where they are allowed", "[fluid][config][pressu
 }
 
 TEST_CASE("a band of even cells with smooth growth outside it", "[fluid][config][band]") {
-  const std::string walls = replace(replace(kGood, "left = { type = \"periodic\" }", "left = { type = \"wall\" }"),
-                                    "right = { type = \"periodic\" }", "right = { type = \"wall\" }");
-  const fluid::Config c = read(replace(walls, "size = [2.0, 1.0]",
-                                       "size = [2.0, 1.0]\ny_band = { from = 0.4, to = 0.6, cells = 4 }"));
+  const std::string walls =
+      replace(replace(kGood, "left = { type = \"periodic\" }", "left = { type = \"wall\" }"),
+              "right = { type = \"periodic\" }", "right = { type = \"wall\" }");
+  const fluid::Config c =
+      read(replace(walls, "size = [2.0, 1.0]",
+                   "size = [2.0, 1.0]\ny_band = { from = 0.4, to = 0.6, cells = 4 }"));
   REQUIRE(c.y.band_cells == 4);
   const fluid::Axis y(c.y);
   CHECK_FALSE(y.uniform());
@@ -159,17 +160,21 @@ TEST_CASE("a band of even cells with smooth growth outside it", "[fluid][config]
   CHECK(l.growth_below > 1.0);
 
   // The same band in x (the transform then runs along y, which must stay uniform).
-  const fluid::Config cx = read(replace(walls, "size = [2.0, 1.0]",
-                                        "size = [2.0, 1.0]\nx_band = { from = 0.5, to = 1.0, cells = 8 }"));
+  const fluid::Config cx =
+      read(replace(walls, "size = [2.0, 1.0]",
+                   "size = [2.0, 1.0]\nx_band = { from = 0.5, to = 1.0, cells = 8 }"));
   const fluid::Axis x(cx.x);
   CHECK_FALSE(x.uniform());
   CHECK(x.hi() == 2.0);
 }
 
 TEST_CASE("bands that cannot be laid out are refused with the key", "[fluid][config][band]") {
-  const std::string walls = replace(replace(kGood, "left = { type = \"periodic\" }", "left = { type = \"wall\" }"),
-                                    "right = { type = \"periodic\" }", "right = { type = \"wall\" }");
-  auto with = [&](const std::string& keys) { return read(replace(walls, "size = [2.0, 1.0]", "size = [2.0, 1.0]\n" + keys)); };
+  const std::string walls =
+      replace(replace(kGood, "left = { type = \"periodic\" }", "left = { type = \"wall\" }"),
+              "right = { type = \"periodic\" }", "right = { type = \"wall\" }");
+  auto with = [&](const std::string& keys) {
+    return read(replace(walls, "size = [2.0, 1.0]", "size = [2.0, 1.0]\n" + keys));
+  };
   CHECK_THROWS_WITH(with("y_band = { from = 0.4, to = 1.2, cells = 8 }"),
                     Contains("fluid.grid.y_band") && Contains("within [0, 1]"));
   CHECK_THROWS_WITH(with("y_band = { from = 0.45, to = 0.55, cells = 14 }"),
@@ -179,10 +184,32 @@ TEST_CASE("bands that cannot be laid out are refused with the key", "[fluid][con
                     Contains("cells") && Contains("more than the direction's 16 cells"));
   CHECK_THROWS_WITH(with("y_band = { from = 0.4, to = 0.6, cells = 4 }\ny_stretch = 1.2"),
                     Contains("fluid.grid.y_band with fluid.grid.y_stretch"));
-  CHECK_THROWS_WITH(with("y_band = { from = 0.4, to = 0.6, cells = 4 }\nx_band = { from = 0.5, to = 1.0, cells = 8 }"),
+  CHECK_THROWS_WITH(with("y_band = { from = 0.4, to = 0.6, cells = 4 }\nx_band = { from = 0.5, to "
+                         "= 1.0, cells = 8 }"),
                     Contains("fluid.grid.x_band with a stretched y"));
-  CHECK_THROWS_WITH(with("y_band = { from = 0.4, to = 0.6, cells = 8, step = 2 }"), Contains("step"));
+  CHECK_THROWS_WITH(with("y_band = { from = 0.4, to = 0.6, cells = 8, step = 2 }"),
+                    Contains("step"));
   // A band along a periodic direction.
-  CHECK_THROWS_WITH(read(replace(kGood, "size = [2.0, 1.0]", "size = [2.0, 1.0]\nx_band = { from = 0.5, to = 1.0, cells = 8 }")),
-                    Contains("fluid.grid.x_band stretches x, which is periodic"));
+  CHECK_THROWS_WITH(
+      read(replace(kGood, "size = [2.0, 1.0]",
+                   "size = [2.0, 1.0]\nx_band = { from = 0.5, to = 1.0, cells = 8 }")),
+      Contains("fluid.grid.x_band stretches x, which is periodic"));
+}
+
+TEST_CASE("a band at a wall, and one over the whole direction", "[fluid][config][band]") {
+  fluid::AxisSpec a;
+  a.cells = 16, a.length = 1.0, a.origin = 0.0;
+  a.band_from = 0.0, a.band_to = 0.25, a.band_cells = 8;  // at the bottom wall
+  const fluid::BandLayout l = fluid::band_layout(a);
+  CHECK(l.below == 0);
+  CHECK(l.above == 8);
+  const fluid::Axis y(a);
+  for (int j = 0; j < 8; ++j) CHECK(y.width(j) == Approx(1.0 / 32).epsilon(1e-12));
+  CHECK(y.hi() == 1.0);
+  // An edge within round-off of the end counts as the end: no cell is squeezed beyond it.
+  a.origin = 0.1, a.length = 0.2, a.band_from = 0.1, a.band_to = 0.3, a.band_cells = 16;
+  CHECK(fluid::band_layout(a).worst() == 1.0);
+  // A band over the whole direction needs all its cells.
+  a.band_cells = 8;
+  CHECK_THROWS_WITH(fluid::band_layout(a), Contains("covers the whole direction"));
 }
