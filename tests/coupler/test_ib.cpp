@@ -1,6 +1,7 @@
 // Feedback-IB transfers: the kernel's moment conditions, exact interpolation of linear fields
 // (also across a periodic boundary), conservation of spread force, interpolation = spreading^T.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -12,7 +13,6 @@ using coupler::testing::grid;
 
 namespace {
 
-
 // Face positions of the two families (u: (x_face[i], y_centre[j]), v: (x_centre[i], y_face[j])).
 void face_xy(const proto::GridInfo& g, int c, std::int32_t f, double& x, double& y) {
   const double hx = g.x_face[1] - g.x_face[0], hy = g.y_face[1] - g.y_face[0];
@@ -20,6 +20,16 @@ void face_xy(const proto::GridInfo& g, int c, std::int32_t f, double& x, double&
   const int i = f % ni, j = f / ni;
   x = g.x_face[0] + (c == 0 ? i * hx : (i + 0.5) * hx);
   y = g.y_face[0] + (c == 0 ? (j + 0.5) * hy : j * hy);
+}
+
+// <f, u>_grid: the spread forces (per unit volume, times the cell's volume) against velocities
+// u given on the sorted sample faces `faces`.
+double grid_dot(const proto::FaceForce& f, const std::vector<std::int32_t>& faces,
+                const std::vector<double>& u, double cell) {
+  double s = 0;
+  for (std::size_t k = 0; k < f.index.size(); ++k)
+    s += f.force[k] * cell * u[std::lower_bound(faces.begin(), faces.end(), f.index[k]) - faces.begin()];
+  return s;
 }
 
 }  // namespace
@@ -136,12 +146,9 @@ TEST_CASE("spreading conserves force and is the transpose of interpolation") {
   ib.store_samples(su, u, sv, v);
   std::vector<double> U;
   ib.interpolate(x, U);
-  double grid_side = 0, marker_side = 0;
-  for (std::size_t k = 0; k < fu.index.size(); ++k)
-    grid_side += fu.force[k] * cell * u[std::lower_bound(su.begin(), su.end(), fu.index[k]) - su.begin()];
-  for (std::size_t k = 0; k < fv.index.size(); ++k)
-    grid_side += fv.force[k] * cell * v[std::lower_bound(sv.begin(), sv.end(), fv.index[k]) - sv.begin()];
+  double marker_side = 0;
   for (std::size_t m = 0; m < F.size(); ++m) marker_side += F[m] * U[m] * w(m);
+  const double grid_side = grid_dot(fu, su, u, cell) + grid_dot(fv, sv, v, cell);
   CHECK(std::abs(grid_side + marker_side) <= 1e-12 * std::abs(marker_side));
 }
 
@@ -191,12 +198,9 @@ TEST_CASE("next to a wall: interpolation over the faces inside, spreading its tr
   ib.take_spread(su, sv, fu, fv);
   const double cell = ib.hx() * ib.hy();
   auto w = [&](std::size_t m) { return m / 2 == 0 || m / 2 == F.size() / 2 - 1 ? 0.5 * ds : ds; };
-  double grid_side = 0, marker_side = 0;
-  for (std::size_t k = 0; k < fu.index.size(); ++k)
-    grid_side += fu.force[k] * cell * u[std::lower_bound(su.begin(), su.end(), fu.index[k]) - su.begin()];
-  for (std::size_t k = 0; k < fv.index.size(); ++k)
-    grid_side += fv.force[k] * cell * v[std::lower_bound(sv.begin(), sv.end(), fv.index[k]) - sv.begin()];
+  double marker_side = 0;
   for (std::size_t m = 0; m < F.size(); ++m) marker_side += F[m] * U[m] * w(m);
+  const double grid_side = grid_dot(fu, su, u, cell) + grid_dot(fv, sv, v, cell);
   CHECK(std::abs(grid_side + marker_side) <= 1e-12 * std::abs(marker_side));
   // The next take finds nothing left over.
   ib.take_spread(su, sv, fu, fv);
