@@ -215,7 +215,7 @@ TEST_CASE("the kept sample stencil equals a fresh one") {
   FeedbackIB kept(g);
   std::vector<std::vector<double>> fibers(3);
   auto place = [&](double shift) {
-    for (int k = 0; k < 3; ++k) {
+    for (std::size_t k = 0; k < fibers.size(); ++k) {
       fibers[k].clear();
       for (int m = 0; m < 20; ++m)
         fibers[k].push_back(std::fmod(0.1 + 0.4 * k + shift + 0.001 * m + 1.2, 1.2)),
