@@ -1,5 +1,6 @@
 // Bad input in the [fluid] table: each error names the key, the value and the file.
 #include <catch2/catch.hpp>
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -27,7 +28,8 @@ top = { type = "wall" }
 )";
 
 fluid::Config read(const std::string& text, double dt = 1e-3) {
-  const std::string path = "fluid_config_test.toml";
+  // In the temporary folder: a run of this binary from a source tree leaves nothing there.
+  const std::string path = (std::filesystem::temp_directory_path() / "fluid_config_test.toml").string();
   std::ofstream(path) << text;
   fsi::Scene scene(path);
   return fluid::read_config(scene.root().table("fluid"), dt);
