@@ -450,6 +450,8 @@ report() {
 
 cmd=${1:-help}
 [ $# -gt 0 ] && shift
+# `exit` on the esac's line: bash has read everything it will run before it starts the command,
+# so a checkout or an edit of this file while a long command runs cannot garble its end.
 case "$cmd" in
   run) run "$@" ;;
   test) test_suite "$@" ;;
@@ -462,4 +464,4 @@ case "$cmd" in
   mpirun) build >/dev/null; compose "$(realpath "${1:?scene}")"; echo "${CMD[*]}" ;;
   help | -h | --help) usage ;;
   *) usage; die "unknown command '$cmd'" ;;
-esac
+esac; exit $?
