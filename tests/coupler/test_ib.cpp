@@ -32,6 +32,20 @@ double grid_dot(const proto::FaceForce& f, const std::vector<std::int32_t>& face
   return s;
 }
 
+// Random velocities u, v on the sample faces su, sv, stored, and U interpolated at markers x.
+void sample_and_interpolate(FeedbackIB& ib, const std::vector<double>& x,
+                            const std::vector<std::int32_t>& su,
+                            const std::vector<std::int32_t>& sv, std::mt19937& rng,
+                            std::vector<double>& u, std::vector<double>& v,
+                            std::vector<double>& U) {
+  std::uniform_real_distribution<double> r(-1, 1);
+  u.resize(su.size()), v.resize(sv.size());
+  for (auto& a : u) a = r(rng);
+  for (auto& a : v) a = r(rng);
+  ib.store_samples(su, u, sv, v);
+  ib.interpolate(x, U);
+}
+
 }  // namespace
 
 TEST_CASE("Peskin's 4-point kernel: partition of unity and zero first moment") {
@@ -140,12 +154,8 @@ TEST_CASE("spreading conserves force and is the transpose of interpolation") {
   CHECK(std::abs(sy + ty) <= 1e-12 * scale);
 
   // <spread(F), u>_grid = −<F, interp(u)>_markers for an arbitrary velocity u.
-  std::vector<double> u(su.size()), v(sv.size());
-  for (auto& a : u) a = r(rng);
-  for (auto& a : v) a = r(rng);
-  ib.store_samples(su, u, sv, v);
-  std::vector<double> U;
-  ib.interpolate(x, U);
+  std::vector<double> u, v, U;
+  sample_and_interpolate(ib, x, su, sv, rng, u, v, U);
   double marker_side = 0;
   for (std::size_t m = 0; m < F.size(); ++m) marker_side += F[m] * U[m] * w(m);
   const double grid_side = grid_dot(fu, su, u, cell) + grid_dot(fv, sv, v, cell);
@@ -173,12 +183,8 @@ TEST_CASE("next to a wall: interpolation over the faces inside, spreading its tr
   }
   std::vector<std::int32_t> su, sv;
   ib.stencil({x}, 1, su, sv);
-  std::vector<double> u(su.size()), v(sv.size());
-  for (auto& a : u) a = r(rng);
-  for (auto& a : v) a = r(rng);
-  ib.store_samples(su, u, sv, v);
-  std::vector<double> U;
-  ib.interpolate(x, U);
+  std::vector<double> u, v, U;
+  sample_and_interpolate(ib, x, su, sv, rng, u, v, U);
   // The same sum written out with the kernel over the faces inside the grid.
   for (std::size_t m = 0; m < x.size(); m += 2)
     for (int c = 0; c < 2; ++c) {
