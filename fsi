@@ -8,7 +8,7 @@ BUILD=${FSI_BUILD_DIR:-$ROOT/build}
 BIN=$BUILD/bin
 DEFAULT_SCENE=$ROOT/runs/default/scene.toml
 PACKAGES=(g++ cmake make pkg-config libeigen3-dev libopenmpi-dev openmpi-bin libhdf5-dev
-          libfftw3-dev catch2 libfmt-dev libtoml11-dev gmsh libgmsh-dev libspectra-dev
+          libfftw3-dev libfftw3-mpi-dev catch2 libfmt-dev libtoml11-dev gmsh libgmsh-dev libspectra-dev
           nlohmann-json3-dev libsuitesparse-dev python3 python3-matplotlib python3-h5py
           python3-numpy python3-mpi4py python3-gmsh)
 # What only the tests need: ParaView (the XDMF test) and a virtual display for it to draw on.
