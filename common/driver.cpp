@@ -66,13 +66,16 @@ nlohmann::json base_summary(const Runtime& rt, long steps) {
 template <class Port, class Advance>
 void run_alone(Runtime& rt, Port& port, Advance advance) {
   const auto& s = rt.settings();
-  write_file_atomically(rt.out_dir() / "scene.effective.toml", rt.scene().effective_toml());
+  // On several ranks (the fluid's), rank 0 writes the run's files and prints its progress.
+  if (rt.is_root())
+    write_file_atomically(rt.out_dir() / "scene.effective.toml", rt.scene().effective_toml());
   const long first = rt.first_step();
   if (!rt.restart_step()) port.output(0, 0.0, is_output_step(s, 0));
   Progress::Options po;
   po.every_steps = s.progress_every;
   po.first_step = first;
   po.first_time = step_time(s, first);
+  po.is_enabled = rt.is_root();
   Progress progress(fmt::format("[{}]", rt.name()), s.steps, step_time(s, s.steps), po);
   long n = first;
   while (n < s.steps) {
@@ -90,7 +93,8 @@ void run_alone(Runtime& rt, Port& port, Advance advance) {
   nlohmann::json j = base_summary(rt, n);
   j["wall_time"][rt.name()] = rt.wall_seconds();
   j[rt.name()] = port.report();
-  write_summary(rt, j);
+  if (rt.program_size() > 1) j[rt.name()]["ranks"] = rt.program_size();
+  if (rt.is_root()) write_summary(rt, j);
   progress.finish(n, step_time(s, n), fmt::format("output in {}", rt.out_dir().string()));
 }
 

@@ -387,7 +387,10 @@ Link& Runtime::link(Role solver) {
 double Runtime::wall_seconds() const { return MPI_Wtime() - m_t0; }
 
 bool Runtime::stop_requested() const {
-  return g_stop_signal != 0 || (m_time_limit > 0 && wall_seconds() > m_time_limit);
+  int stop = g_stop_signal != 0 || (m_time_limit > 0 && wall_seconds() > m_time_limit);
+  if (m_program_size > 1)
+    MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_LOR, m_program_comm);
+  return stop != 0;
 }
 
 void Runtime::check_fault(long step) const {
@@ -454,8 +457,14 @@ void check_job(const Runtime& rt, const std::vector<Announce>& all, const RoleSe
            "program once",
            who, appnum[a.role], a.appnum);
     appnum[a.role] = a.appnum;
-    if (a.local_size != 1)
-      fail("{} was launched on {} ranks; each program runs on 1 rank (-n 1)", who, a.local_size);
+    // The fluid may run on several ranks (a grid split in slabs), alone for now: the coupler
+    // talks to one fluid rank.
+    if (a.local_size != 1 && (a.role != static_cast<int>(Role::fluid) || need[Role::coupler]))
+      fail("{} was launched on {} ranks; {}", who, a.local_size,
+           a.role == static_cast<int>(Role::fluid)
+               ? "a coupled scene runs the fluid on 1 rank so far (-n 1 fluid); a fluid-only "
+                 "scene may run on several"
+               : "it runs on 1 rank (-n 1); only the fluid may run on several");
   }
   std::vector<std::string> missing, launched;
   for (int r = 0; r < kRoleCount; ++r) {
@@ -488,6 +497,9 @@ int run_program(Role role, int argc, char** argv, const std::function<void(Runti
     MPI_Comm_split(MPI_COMM_WORLD, appnum, world_rank, &local);
     int local_size = 1;
     MPI_Comm_size(local, &local_size);
+    rt.m_program_comm = local;
+    rt.m_program_size = local_size;
+    MPI_Comm_rank(local, &rt.m_program_rank);
 
     const Options opts = parse_options(argc, argv, rt.name());
     rt.m_scene = std::make_unique<Scene>(opts.scene);

@@ -125,8 +125,16 @@ class Runtime {
   // First step this run computes: 0, or the restart step.
   long first_step() const { return m_restart_step.value_or(0); }
   // Whether the run was asked to stop (SIGUSR1, SIGTERM or SIGINT to this program, or the wall
-  // time of --time-limit passed): checkpoint, then stop. Cheap; polled once a step.
+  // time of --time-limit passed): checkpoint, then stop. Cheap; polled once a step. A program on
+  // several ranks answers for all of them (collective: one reduction).
   bool stop_requested() const;
+  // This program's own ranks (the fluid may run on several; the others on one): their
+  // communicator, this one's rank among them, how many. Files of the program are written by its
+  // rank 0 (is_root()).
+  MPI_Comm program_comm() const { return m_program_comm; }
+  int program_rank() const { return m_program_rank; }
+  int program_size() const { return m_program_size; }
+  bool is_root() const { return m_program_rank == 0; }
   // The test-only fault switch: throws when this program is told to fail at `step`.
   void check_fault(long step) const;
 
@@ -139,6 +147,8 @@ class Runtime {
   std::filesystem::path m_out_dir;
   std::array<std::unique_ptr<Link>, kRoleCount> m_links;
   double m_t0 = 0;
+  MPI_Comm m_program_comm = MPI_COMM_NULL;
+  int m_program_rank = 0, m_program_size = 1;
   std::optional<long> m_restart_step;
   double m_time_limit = 0;
 };

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "config.hpp"
+#include "decomposition.hpp"
 #include "field.hpp"
 #include "grid.hpp"
 #include "h5.hpp"
@@ -37,7 +38,9 @@ using FacePressure = std::array<std::vector<double>, 2>;
 
 class Boundaries {
  public:
-  Boundaries(const Grid& g, const std::array<SideBc, 4>& bc);
+  // d: the rows this process holds (its loops run over them; sums over the sides are taken
+  // over all ranks, in the same order of collectives on every rank).
+  Boundaries(const Grid& g, const std::array<SideBc, 4>& bc, const Decomposition& d = {});
   const SideBc& side(int s) const { return m_bc[s]; }
   const GhostRule& rule(int s) const { return m_rule[s]; }
   bool has_outflow() const { return m_has_outflow; }
@@ -63,7 +66,14 @@ class Boundaries {
   void load(const fsi::H5File& h5, const std::string& group);
 
  private:
+  // Rows [k0, k1) of a left/right side (cell rows; v: up to v_hi) and whether a bottom/top
+  // side is on this rank.
+  int row_lo() const { return m_d.lo(); }
+  int row_hi() const { return m_d.hi(); }
+  bool holds(int s) const { return s < 2 || (s == bottom ? m_d.has_bottom() : m_d.has_top()); }
+
   const Grid& m_g;
+  Decomposition m_d;
   std::array<SideBc, 4> m_bc;
   std::array<GhostRule, 4> m_rule;
   bool m_has_outflow = false;

@@ -9,6 +9,15 @@
 
 namespace fluid {
 
+namespace {
+// The largest of the ranks' extrema (a NaN above every number), on every rank.
+Extremum largest(const Decomposition& d, Extremum e) {
+  if (d.serial()) return e;
+  d.broadcast(&e, sizeof e, d.argmax(e.value));
+  return e;
+}
+}  // namespace
+
 // Row by row: the row's largest value in a loop without branches (which the compiler
 // vectorises), then the cell that holds the largest value
 // only for a row that beats the best so far. Every step runs this; the location is rarely needed.
@@ -22,7 +31,8 @@ Extremum cfl(const Solver& s, double dt) {
     return std::max(std::abs(u[i]), std::abs(u[i + 1])) * xwi[i] +
            std::max(std::abs(v[i]), std::abs(vn[i])) * wy + 0.0 * (u[i] + u[i + 1] + v[i] + vn[i]);
   };
-  for (int j = 0; j < g.ny(); ++j) {
+  const Decomposition& d = s.decomposition();
+  for (int j = d.lo(); j < d.hi(); ++j) {
     const double* u = s.u().row(j);
     const double* v = s.v().row(j);
     const double* vn = s.v().row(j + 1);
@@ -38,7 +48,7 @@ Extremum cfl(const Solver& s, double dt) {
     const double m = std::bit_cast<double>(mb);
     if (!std::isfinite(m)) {
       e = {std::numeric_limits<double>::quiet_NaN(), 0, j, g.x().centre(0), g.y().centre(j)};
-      return e;
+      break;
     }
     if (m <= e.value) continue;
     e = {m, 0, j, g.x().centre(0), g.y().centre(j)};
@@ -49,14 +59,15 @@ Extremum cfl(const Solver& s, double dt) {
       }
   }
   e.value *= dt;
-  return e;
+  return largest(d, e);
 }
 
 Extremum max_divergence(const Solver& s) {
   const Grid& g = s.grid();
   const double *xwi = g.x().wi(), *ywi = g.y().wi();
   Extremum e;
-  for (int j = 0; j < g.ny(); ++j) {
+  const Decomposition& dec = s.decomposition();
+  for (int j = dec.lo(); j < dec.hi(); ++j) {
     const double* u = s.u().row(j);
     const double* v = s.v().row(j);
     const double* vn = s.v().row(j + 1);
@@ -65,7 +76,7 @@ Extremum max_divergence(const Solver& s) {
       if (!(d <= e.value)) e = {d, i, j, g.x().centre(i), g.y().centre(j)};
     }
   }
-  return e;
+  return largest(dec, e);
 }
 
 double kinetic_energy(const Solver& s, double x_lo, double x_hi, std::array<double, 2> ref) {
@@ -74,7 +85,8 @@ double kinetic_energy(const Solver& s, double x_lo, double x_hi, std::array<doub
   const Axis& Y = g.y();
   double e = 0;
   const int iu_end = X.periodic() ? g.nx() : g.nx() + 1;
-  for (int j = 0; j < g.ny(); ++j) {
+  const Decomposition& d = s.decomposition();
+  for (int j = d.lo(); j < d.hi(); ++j) {
     for (int i = 0; i < iu_end; ++i) {
       const double x = X.face(i);
       if (x < x_lo || x > x_hi) continue;
@@ -86,8 +98,8 @@ double kinetic_energy(const Solver& s, double x_lo, double x_hi, std::array<doub
       e += q * q * w * Y.width(j);
     }
   }
-  const int jv_end = Y.periodic() ? g.ny() : g.ny() + 1;
-  for (int j = 0; j < jv_end; ++j) {
+  const int jv_end = std::min(Y.periodic() ? g.ny() : g.ny() + 1, d.v_hi());
+  for (int j = d.lo(); j < jv_end; ++j) {
     double w = 0.5 * ((j > 0 || Y.periodic() ? Y.width(j - 1) : 0.0) + (j < g.ny() ? Y.width(j) : 0.0));
     for (int i = 0; i < g.nx(); ++i) {
       const double x = X.centre(i);
@@ -96,7 +108,7 @@ double kinetic_energy(const Solver& s, double x_lo, double x_hi, std::array<doub
       e += q * q * w * X.width(i);
     }
   }
-  return 0.5 * s.config().density * e;
+  return 0.5 * s.config().density * d.sum(e);
 }
 
 namespace {
@@ -139,8 +151,13 @@ double sample(const Solver& s, int q, double x, double y) {
   else bracket(xc, -1, g.nx() + 1, x, i, wx);
   if (q == 1) bracket(yf, 0, g.ny() + 1, y, j, wy);
   else bracket(yc, -1, g.ny() + 1, y, j, wy);
-  return (1 - wx) * (1 - wy) * f(i, j) + wx * (1 - wy) * f(i + 1, j) + (1 - wx) * wy * f(i, j + 1) +
-         wx * wy * f(i + 1, j + 1);
+  // On several ranks the rank holding row j interpolates (row j + 1 is at most its ghost row).
+  const Decomposition& d = s.decomposition();
+  const bool here = d.serial() || d.owner(j) == d.rank();
+  const double value = here ? (1 - wx) * (1 - wy) * f(i, j) + wx * (1 - wy) * f(i + 1, j) +
+                                  (1 - wx) * wy * f(i, j + 1) + wx * wy * f(i + 1, j + 1)
+                            : 0.0;
+  return d.sum(value);
 }
 
 std::vector<double> wall_shear(const Solver& s, Side side, std::vector<double>* position) {
@@ -159,16 +176,25 @@ std::vector<double> wall_shear(const Solver& s, Side side, std::vector<double>* 
   const double wall = bc.type == BcType::wall ? bc.wall_speed(s.time()) : 0.0;
   const int q0 = hi ? n - 1 : 0, q1 = hi ? n - 2 : 1;
   const int m = o.periodic() ? o.n() : o.n() + 1;
-  std::vector<double> tau(m);
+  std::vector<double> tau(m, 0.0);
   if (position) position->resize(m);
-  // With n into the fluid and t along +x or +y: tau = mu d(u_t)/dn.
+  // With n into the fluid and t along +x or +y: tau = mu d(u_t)/dn. On several ranks each
+  // computes the positions it holds (a left or right side's rows, a bottom or top side on its
+  // rank) and the sum over the ranks gathers them.
   const double mu = s.config().viscosity;
-  for (int k = 0; k < m; ++k) {
+  const Decomposition& d = s.decomposition();
+  const int k0 = a == 0 ? d.lo() : 0;
+  const int k1 = a == 0                          ? std::min(m, d.v_hi())
+                 : (hi ? d.has_top() : d.has_bottom()) ? m
+                                                     : 0;
+  for (int k = 0; k < m; ++k)
+    if (position) (*position)[k] = o.face(k);
+  for (int k = k0; k < k1; ++k) {
     const double v0 = a == 0 ? t(q0, k) : t(k, q0);
     const double v1 = a == 0 ? t(q1, k) : t(k, q1);
     tau[k] = mu * (dw * wall + d0 * v0 + d1 * v1);
-    if (position) (*position)[k] = o.face(k);
   }
+  d.sum(tau.data(), m);
   return tau;
 }
 
@@ -184,33 +210,37 @@ int nearest_u_column(const Solver& s, double x) {
 double flow_rate(const Solver& s, int i) {
   const Axis& Y = s.grid().y();
   double q = 0;
-  for (int j = 0; j < s.grid().ny(); ++j) q += s.u()(i, j) * Y.width(j);
-  return q;
+  const Decomposition& d = s.decomposition();
+  for (int j = d.lo(); j < d.hi(); ++j) q += s.u()(i, j) * Y.width(j);
+  return d.sum(q);
 }
 
 void vorticity(const Solver& s, std::vector<double>& out) {
   const Grid& g = s.grid();
-  const int nx = g.nx(), ny = g.ny();
+  const int nx = g.nx();
   const double *xdi = g.x().di(), *ydi = g.y().di();
-  out.resize(std::size_t(nx) * ny);
+  const Decomposition& d = s.decomposition();
+  out.resize(std::size_t(nx) * (d.hi() - d.lo()));
   auto corner = [&](int i, int j) {
     return (s.v()(i, j) - s.v()(i - 1, j)) * xdi[i] - (s.u()(i, j) - s.u()(i, j - 1)) * ydi[j];
   };
-  for (int j = 0; j < ny; ++j)
+  for (int j = d.lo(); j < d.hi(); ++j)
     for (int i = 0; i < nx; ++i)
-      out[i + std::size_t(nx) * j] =
+      out[i + std::size_t(nx) * (j - d.lo())] =
           0.25 * (corner(i, j) + corner(i + 1, j) + corner(i, j + 1) + corner(i + 1, j + 1));
 }
 
 void centred_velocity(const Solver& s, std::vector<double>& uc, std::vector<double>& vc) {
   const Grid& g = s.grid();
-  const int nx = g.nx(), ny = g.ny();
-  uc.resize(std::size_t(nx) * ny);
-  vc.resize(std::size_t(nx) * ny);
-  for (int j = 0; j < ny; ++j)
+  const int nx = g.nx();
+  const Decomposition& d = s.decomposition();
+  const int lo = d.lo(), rows = d.hi() - d.lo();
+  uc.resize(std::size_t(nx) * rows);
+  vc.resize(std::size_t(nx) * rows);
+  for (int j = lo; j < d.hi(); ++j)
     for (int i = 0; i < nx; ++i) {
-      uc[i + std::size_t(nx) * j] = 0.5 * (s.u()(i, j) + s.u()(i + 1, j));
-      vc[i + std::size_t(nx) * j] = 0.5 * (s.v()(i, j) + s.v()(i, j + 1));
+      uc[i + std::size_t(nx) * (j - lo)] = 0.5 * (s.u()(i, j) + s.u()(i + 1, j));
+      vc[i + std::size_t(nx) * (j - lo)] = 0.5 * (s.v()(i, j) + s.v()(i, j + 1));
     }
 }
 

@@ -1,5 +1,7 @@
 // Diagnostics of the fluid state: CFL number, discrete divergence, kinetic energy, point
 // samples, wall shear stress (paper Eq. 30), vorticity and cell-centred velocities for output.
+// On a fluid split over ranks each is collective and returns the whole grid's value on every
+// rank, except the two output fields (vorticity, centred velocity): this rank's rows.
 #pragma once
 
 #include <array>
@@ -43,9 +45,10 @@ int nearest_u_column(const Solver& s, double x);
 // (the flux the discrete divergence balances, so the same in every column of a steady flow
 // without sources; inside an immersed body it counts the forced velocity, i.e. the body's).
 double flow_rate(const Solver& s, int i);
-// Vorticity dv/dx - du/dy at the cell centres (nx * ny, i fastest): mean of the four corners.
+// Vorticity dv/dx - du/dy at the cell centres (nx per row of this rank, i fastest): mean of the
+// four corners.
 void vorticity(const Solver& s, std::vector<double>& out);
-// Cell-centred velocity (nx * ny, i fastest).
+// Cell-centred velocity (nx per row of this rank, i fastest).
 void centred_velocity(const Solver& s, std::vector<double>& uc, std::vector<double>& vc);
 
 }  // namespace fluid

@@ -11,25 +11,31 @@
 namespace fluid {
 
 struct Field {
-  int ni = 0, nj = 0;  // interior extents; storage is (ni + 2) x (nj + 2)
+  int ni = 0, nj = 0;  // interior extents of the whole grid
+  int jlo = 0, jhi = 0;  // the rows this process stores besides its ghosts: [jlo, jhi)
   int sx = 0;          // stride between rows
   std::vector<double> a;
 
   Field() = default;
-  Field(int ni_, int nj_)
-      : ni(ni_), nj(nj_), sx(ni_ + 2), a(std::size_t(ni_ + 2) * (nj_ + 2), 0.0) {}
-  // (i, j) with i in [-1, ni], j in [-1, nj] (checked in debug builds)
+  // The whole grid: storage (ni + 2) x (nj + 2).
+  Field(int ni_, int nj_) : Field(ni_, nj_, 0, nj_) {}
+  // Rows [jlo_, jhi_) of the grid (a slab of the fluid split over ranks) with a ghost row on each
+  // side; indices stay the whole grid's.
+  Field(int ni_, int nj_, int jlo_, int jhi_)
+      : ni(ni_), nj(nj_), jlo(jlo_), jhi(jhi_), sx(ni_ + 2),
+        a(std::size_t(ni_ + 2) * (jhi_ - jlo_ + 2), 0.0) {}
+  // (i, j) with i in [-1, ni], j in [jlo - 1, jhi] (checked in debug builds)
   double& operator()(int i, int j) {
-    FSI_ASSERT(i >= -1 && i <= ni && j >= -1 && j <= nj);
-    return a[std::size_t(i + 1) + std::size_t(sx) * (j + 1)];
+    FSI_ASSERT(i >= -1 && i <= ni && j >= jlo - 1 && j <= jhi);
+    return a[std::size_t(i + 1) + std::size_t(sx) * (j - jlo + 1)];
   }
   double operator()(int i, int j) const {
-    FSI_ASSERT(i >= -1 && i <= ni && j >= -1 && j <= nj);
-    return a[std::size_t(i + 1) + std::size_t(sx) * (j + 1)];
+    FSI_ASSERT(i >= -1 && i <= ni && j >= jlo - 1 && j <= jhi);
+    return a[std::size_t(i + 1) + std::size_t(sx) * (j - jlo + 1)];
   }
   // Pointer to element (0, j); valid offsets -1 .. ni.
-  double* row(int j) { return a.data() + 1 + std::size_t(sx) * (j + 1); }
-  const double* row(int j) const { return a.data() + 1 + std::size_t(sx) * (j + 1); }
+  double* row(int j) { return a.data() + 1 + std::size_t(sx) * (j - jlo + 1); }
+  const double* row(int j) const { return a.data() + 1 + std::size_t(sx) * (j - jlo + 1); }
 };
 
 }  // namespace fluid

@@ -15,7 +15,7 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
     const auto [i, j] = face_of(0, in.solid_u_index[q]);
     double f = 0;
     if (i >= m_iu0 && i < m_iu1) {
-      double& u = m_u(i, j);
+      double& u = m_u(i, owned(j, 0));
       f = rho * in.solid_u_alpha[q] * (in.solid_u_velocity[q] - u) / dt;
       u += dt * f / rho;
     }
@@ -24,7 +24,7 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
   for (std::size_t q = 0; q < in.solid_v_index.size(); ++q) {
     const auto [i, j] = face_of(1, in.solid_v_index[q]);
     double f = 0;
-    if (j >= m_j0 && j < ny) {
+    if (j >= m_j0 && owned(j, 1) < ny) {
       double& v = m_v(i, j);
       f = rho * in.solid_v_alpha[q] * (in.solid_v_velocity[q] - v) / dt;
       v += dt * f / rho;

@@ -9,7 +9,7 @@ namespace fluid {
 void set_initial(Solver& s) {
   const Initial& in = s.config().initial;
   const Grid& g = s.grid();
-  const int nx = g.nx(), ny = g.ny();
+  const int nx = g.nx();
   const double pi = std::numbers::pi;
   auto velocity = [&](double x, double y) -> std::array<double, 2> {
     switch (in.type) {
@@ -32,9 +32,11 @@ void set_initial(Solver& s) {
     }
     return {0, 0};
   };
-  for (int j = 0; j < ny; ++j)
+  // The rows this rank holds (all of them on one rank).
+  const Decomposition& d = s.decomposition();
+  for (int j = d.lo(); j < d.hi(); ++j)
     for (int i = 0; i <= nx; ++i) s.u()(i, j) = velocity(g.x().face(i), g.y().centre(j))[0];
-  for (int j = 0; j <= ny; ++j)
+  for (int j = d.lo(); j < d.v_hi(); ++j)
     for (int i = 0; i < nx; ++i) s.v()(i, j) = velocity(g.x().centre(i), g.y().face(j))[1];
   s.project_initial();
 }

@@ -2,6 +2,8 @@
 // spacings.
 #include "momentum.hpp"
 
+#include <algorithm>
+
 namespace fluid {
 
 SpongeWeights sponge_weights(const Grid& g, double blend) {
@@ -52,7 +54,8 @@ void kernel(const Grid& g, const SpongeWeights& sw, const Field& u, const Field&
   const double* bc = Upwind ? sw.centre.data() + 1 : nullptr;
   const double* bf = Upwind ? sw.face.data() + 1 : nullptr;
 
-  for (int j = 0; j < ny; ++j) {
+  // The rows this process holds (hu's; on one rank all of them).
+  for (int j = hu.jlo; j < hu.jhi; ++j) {
     const double* uc = u.row(j);
     const double* un = u.row(j + 1);
     const double* us = u.row(j - 1);
@@ -86,7 +89,7 @@ void kernel(const Grid& g, const SpongeWeights& sw, const Field& u, const Field&
     }
   }
 
-  for (int j = j0; j < ny; ++j) {
+  for (int j = std::max(j0, hv.jlo); j < std::min(ny, hv.jhi); ++j) {
     const double* vc = v.row(j);
     const double* vn = v.row(j + 1);
     const double* vs = v.row(j - 1);

@@ -23,10 +23,10 @@ void Solver::predictor(double dt, double t_half) {
   const double c0 = m_step == 0 ? 0.0 : -0.5 * dt / m_dt_prev;
   const auto acc = body_acceleration(t_half);
   const double ri = 1.0 / m_cfg.density;
-  const int nx = m_grid.nx(), ny = m_grid.ny();
+  const int nx = m_grid.nx();
   const double* xdi = m_grid.x().di();
   const double* ydi = m_grid.y().di();
-  for (int j = 0; j < ny; ++j) {
+  for (int j = row_lo(); j < row_hi(); ++j) {
     double* u = m_u.row(j);
     const double* h = m_hu.row(j);
     const double* ho = m_hu_old.row(j);
@@ -41,7 +41,7 @@ void Solver::predictor(double dt, double t_half) {
     if (m_bnd.is_pressure(right))
       u[nx] += dt * (c1 * h[nx - 1] + c0 * ho[nx - 1] + acc[0] - ri * (p[nx] - p[nx - 1]) * xdi[nx]);
   }
-  for (int j = m_j0; j < ny; ++j) {
+  for (int j = v_row_lo(); j < row_hi(); ++j) {
     double* v = m_v.row(j);
     const double* h = m_hv.row(j);
     const double* ho = m_hv_old.row(j);
@@ -65,10 +65,10 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
       const auto& idx = comp == 0 ? in.fiber_u_index : in.fiber_v_index;
       const auto& frc = comp == 0 ? in.fiber_u_force : in.fiber_v_force;
       const int ib = comp == 0 ? m_i0 : 0, jb = comp == 0 ? 0 : m_j0;
-      const int nt = (comp == 0 ? m_helm_u : m_helm_v)->nt();
+      const int nt = solve_nt(comp);
       for (std::size_t q = 0; q < idx.size(); ++q) {
         const auto [i, j] = face_of(comp, idx[q]);
-        if (i < ib || i >= nx || j < jb || j >= ny) continue;
+        if (i < ib || i >= nx || j < jb || owned(j, comp) >= ny) continue;
         m_rhs[comp][buf_index(i, j, ib, jb, nt)] += scale * dt * ri * frc[q];
       }
     }
@@ -76,11 +76,11 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
   }
   for (std::size_t q = 0; q < in.fiber_u_index.size(); ++q) {
     const auto [i, j] = face_of(0, in.fiber_u_index[q]);
-    if (i >= m_iu0 && i < m_iu1) m_u(i, j) += dt * ri * in.fiber_u_force[q];
+    if (i >= m_iu0 && i < m_iu1) m_u(i, owned(j, 0)) += dt * ri * in.fiber_u_force[q];
   }
   for (std::size_t q = 0; q < in.fiber_v_index.size(); ++q) {
     const auto [i, j] = face_of(1, in.fiber_v_index[q]);
-    if (j >= m_j0 && j < ny) m_v(i, j) += dt * ri * in.fiber_v_force[q];
+    if (j >= m_j0 && owned(j, 1) < ny) m_v(i, j) += dt * ri * in.fiber_v_force[q];
   }
 }
 
@@ -105,7 +105,7 @@ void Solver::predictor_implicit(double dt, double t_half) {
   const auto acc = body_acceleration(t_half);
   const double ri = 1.0 / m_cfg.density;
   const double theta = 0.5 * m_nu * dt, scale = -1.0 / theta;
-  const int nx = m_grid.nx(), ny = m_grid.ny();
+  const int nx = m_grid.nx();
   const Axis& X = m_grid.x();
   const Axis& Y = m_grid.y();
 
@@ -114,13 +114,14 @@ void Solver::predictor_implicit(double dt, double t_half) {
     const Field& H = comp == 0 ? m_hu : m_hv;
     const Field& Ho = comp == 0 ? m_hu_old : m_hv_old;
     const Field& L = comp == 0 ? m_lu : m_lv;
-    const FastSolver& hs = comp == 0 ? *m_helm_u : *m_helm_v;
     const int ib = comp == 0 ? m_i0 : 0, jb = comp == 0 ? 0 : m_j0;
-    const int nt = hs.nt();
+    const int nt = solve_nt(comp);
+    // Rows of the unknowns on this rank: [jr, row_hi()) (one rank: [jb, ny)).
+    const int jr = std::max(jb, row_lo());
     std::vector<double>& buf = m_rhs[comp];
-    buf.resize(std::size_t(hs.nt()) * hs.ns());
+    buf.resize(solve_size(comp));
     const double* gd = comp == 0 ? X.di() : Y.di();
-    for (int j = jb; j < ny; ++j) {
+    for (int j = jr; j < row_hi(); ++j) {
       const double* f = F.row(j);
       const double* h = H.row(j);
       const double* ho = Ho.row(j);
@@ -144,7 +145,10 @@ void Solver::predictor_implicit(double dt, double t_half) {
       const bool hi = s % 2;
       const Axis& ax = m_grid.axis(a);
       const int n = ax.n();
-      const int kb = a == 0 ? jb : ib, ke = a == 0 ? ny : nx;  // range along the side
+      // Range along the side on this rank: its rows (left, right) or, when it holds the side,
+      // the columns (bottom, top).
+      const bool here = a == 0 || (hi ? m_dec.has_top() : m_dec.has_bottom());
+      const int kb = a == 0 ? jr : ib, ke = a == 0 ? row_hi() : here ? nx : ib;
       auto val = [&](int nidx, int k) { return a == 0 ? F(nidx, k) : F(k, nidx); };
       auto add = [&](int nidx, int k, double x) {
         const int i = a == 0 ? nidx : k, j = a == 0 ? k : nidx;
@@ -174,17 +178,16 @@ void Solver::predictor_implicit(double dt, double t_half) {
 // The Crank-Nicolson solve of the step: u~ = (I - theta L)^-1 B on the interior faces
 // (predictor_implicit); the immersed forcing follows on u~.
 void Solver::solve_implicit() {
-  const int nx = m_grid.nx(), ny = m_grid.ny();
+  const int nx = m_grid.nx();
   for (int comp = 0; comp < 2; ++comp) {
     Field& F = comp == 0 ? m_u : m_v;
-    FastSolver& hs = comp == 0 ? *m_helm_u : *m_helm_v;
     const int ib = comp == 0 ? m_i0 : 0, jb = comp == 0 ? 0 : m_j0;
-    const int nt = hs.nt();
+    const int nt = solve_nt(comp);
     const std::vector<double>& rhs = m_rhs[comp];
-    double* buf = hs.data();
+    double* buf = solve_data(comp);
     std::copy(rhs.begin(), rhs.end(), buf);
-    hs.solve();
-    for (int j = jb; j < ny; ++j) {
+    solve(comp);
+    for (int j = std::max(jb, row_lo()); j < row_hi(); ++j) {
       double* f = F.row(j);
       for (int i = ib; i < nx; ++i) f[i] = buf[buf_index(i, j, ib, jb, nt)];
     }

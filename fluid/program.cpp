@@ -15,33 +15,44 @@ namespace fluid {
 FluidProgram::FluidProgram(fsi::Runtime& rt)
     : m_rt(rt),
       m_cfg(read_config(rt.root().table("fluid"), rt.settings().dt)),
-      m_solver(std::make_unique<Solver>(m_cfg, rt.settings().dt)),
-      m_h5(fsi::output_h5(rt, rt.out_dir() / "fluid.h5")) {
+      m_solver(std::make_unique<Solver>(m_cfg, rt.settings().dt, rt.program_comm())) {
+  if (rt.program_size() > 1 && (rt.settings().checkpoint_interval > 0 || rt.restart_step()))
+    throw fsi::InputError(fmt::format(
+        "{}: the fluid on {} ranks writes no checkpoints yet; set output.checkpoint_interval = 0 "
+        "(it is {:g}) and start afresh, or run the fluid on 1 rank",
+        rt.scene().file().string(), rt.program_size(), rt.settings().checkpoint_interval));
   set_initial(*m_solver);
   const Grid& g = m_solver->grid();
+  // Rank 0 writes the files; the diagnostics below are collective over the fluid's ranks.
+  const bool root = rt.is_root();
   std::vector<double> xf(g.nx() + 1), yf(g.ny() + 1);
   for (int i = 0; i <= g.nx(); ++i) xf[i] = g.x().face(i);
   for (int j = 0; j <= g.ny(); ++j) yf[j] = g.y().face(j);
-  m_h5.create_group("grid");
-  m_h5.write("grid/x_face", xf);
-  m_h5.write("grid/y_face", yf);
-  m_h5.write("grid/nodes", fsi::rectilinear_nodes(xf, yf), {yf.size() * xf.size(), 2});
-  m_h5.set_attribute("grid", "density", m_cfg.density);
-  m_h5.set_attribute("grid", "viscosity", m_cfg.viscosity);
+  if (root) {
+    m_h5.emplace(fsi::output_h5(rt, rt.out_dir() / "fluid.h5"));
+    m_h5->create_group("grid");
+    m_h5->write("grid/x_face", xf);
+    m_h5->write("grid/y_face", yf);
+    m_h5->write("grid/nodes", fsi::rectilinear_nodes(xf, yf), {yf.size() * xf.size(), 2});
+    m_h5->set_attribute("grid", "density", m_cfg.density);
+    m_h5->set_attribute("grid", "viscosity", m_cfg.viscosity);
+  }
   for (Side s : m_cfg.wall_shear) {
     std::vector<double> pos;
     wall_shear(*m_solver, s, &pos);
-    m_h5.write(fmt::format("grid/tau_{}_position", kSideNames[s]), pos);
+    if (root) m_h5->write(fmt::format("grid/tau_{}_position", kSideNames[s]), pos);
   }
-  m_xdmf.emplace(rt.out_dir() / "fluid.xdmf", rt.out_dir() / "fluid.h5",
-                 fsi::XdmfStructured{"/grid/nodes", xf.size(), yf.size()},
-                 "fluid");
-  if (rt.restart_step()) m_xdmf->resume(fsi::restart_fields_time(rt));
+  if (root) {
+    m_xdmf.emplace(rt.out_dir() / "fluid.xdmf", rt.out_dir() / "fluid.h5",
+                   fsi::XdmfStructured{"/grid/nodes", xf.size(), yf.size()}, "fluid");
+    if (rt.restart_step()) m_xdmf->resume(fsi::restart_fields_time(rt));
+  }
   if (!m_cfg.probes.empty()) {
     std::vector<std::string> names;
     for (const Probe& p : m_cfg.probes) names.push_back(p.name);
-    m_probes.emplace(fsi::output_csv(rt, rt.out_dir() / "fluid_probes.csv",
-                                     fsi::probe_columns(names, {"ux", "uy", "p"})));
+    if (root)
+      m_probes.emplace(fsi::output_csv(rt, rt.out_dir() / "fluid_probes.csv",
+                                       fsi::probe_columns(names, {"ux", "uy", "p"})));
     m_row.resize(3 * names.size());
   }
   if (!m_cfg.flow_rate.empty()) {
@@ -50,7 +61,7 @@ FluidProgram::FluidProgram(fsi::Runtime& rt)
       m_flow_columns.push_back(nearest_u_column(*m_solver, m_cfg.flow_rate[k]));
       cols.push_back(fmt::format("Q{}", k));
     }
-    m_flow.emplace(fsi::output_csv(rt, rt.out_dir() / "fluid_flow_rate.csv", cols));
+    if (root) m_flow.emplace(fsi::output_csv(rt, rt.out_dir() / "fluid_flow_rate.csv", cols));
     m_flow_row.resize(cols.size());
   }
 }
@@ -145,34 +156,52 @@ void FluidProgram::check_health(long step, double t, double dt) {
                   what, (m_rt.out_dir() / "fluid.h5").string()));
 }
 
+// Collective over the fluid's ranks: each gives its rows, rank 0 writes the whole grid's.
 void FluidProgram::write_fields(long step, double t) {
   if (step == m_written_step) return;
   m_written_step = step;
   const Solver& s = *m_solver;
   const Grid& g = s.grid();
+  const Decomposition& d = s.decomposition();
+  const int nx = g.nx(), ny = g.ny(), lo = d.lo(), rows = d.hi() - d.lo();
+  const bool root = m_rt.is_root();
   const std::string grp = fsi::h5_step_group(step);
-  m_h5.create_group(grp);
-  m_h5.set_attribute(grp, "time", t);
-  const fsi::H5Shape shape{std::size_t(g.ny()), std::size_t(g.nx())};
-  centred_velocity(s, m_w1, m_w2);
-  m_h5.write(grp + "/u", m_w1, shape);
-  m_h5.write(grp + "/v", m_w2, shape);
-  for (int j = 0; j < g.ny(); ++j)
-    for (int i = 0; i < g.nx(); ++i) m_w1[i + std::size_t(g.nx()) * j] = s.p()(i, j);
-  m_h5.write(grp + "/p", m_w1, shape);
-  vorticity(s, m_w1);
-  m_h5.write(grp + "/vorticity", m_w1, shape);
-  // The staggered fields themselves, for exact post-processing.
-  std::vector<double> uf(std::size_t(g.nx() + 1) * g.ny()), vf(std::size_t(g.nx()) * (g.ny() + 1));
-  for (int j = 0; j < g.ny(); ++j)
-    for (int i = 0; i <= g.nx(); ++i) uf[i + std::size_t(g.nx() + 1) * j] = s.u()(i, j);
-  for (int j = 0; j <= g.ny(); ++j)
-    for (int i = 0; i < g.nx(); ++i) vf[i + std::size_t(g.nx()) * j] = s.v()(i, j);
-  m_h5.write(grp + "/u_face", uf, {std::size_t(g.ny()), std::size_t(g.nx() + 1)});
-  m_h5.write(grp + "/v_face", vf, {std::size_t(g.ny() + 1), std::size_t(g.nx())});
-  for (Side side : m_cfg.wall_shear) {
-    m_h5.write(fmt::format("{}/tau_{}", grp, kSideNames[side]), wall_shear(s, side));
+  if (root) {
+    m_h5->create_group(grp);
+    m_h5->set_attribute(grp, "time", t);
   }
+  const fsi::H5Shape shape{std::size_t(ny), std::size_t(nx)};
+  std::vector<double> all(root ? std::size_t(nx + 1) * (ny + 1) : 0);
+  // This rank's rows of one field (n per row, `extra` rows more on the last rank) to rank 0,
+  // written there as `name`.
+  auto write = [&](const std::string& name, const std::vector<double>& mine, int n, int extra,
+                   fsi::H5Shape sh) {
+    d.gather_rows(mine.data(), n, int(mine.size() / std::max(1, n)), all.data(), extra);
+    if (root) m_h5->write(name, std::vector<double>(all.begin(), all.begin() + sh[0] * sh[1]), sh);
+  };
+  centred_velocity(s, m_w1, m_w2);
+  write(grp + "/u", m_w1, nx, 0, shape);
+  write(grp + "/v", m_w2, nx, 0, shape);
+  m_w1.resize(std::size_t(nx) * rows);
+  for (int j = lo; j < d.hi(); ++j)
+    for (int i = 0; i < nx; ++i) m_w1[i + std::size_t(nx) * (j - lo)] = s.p()(i, j);
+  write(grp + "/p", m_w1, nx, 0, shape);
+  vorticity(s, m_w1);
+  write(grp + "/vorticity", m_w1, nx, 0, shape);
+  // The staggered fields themselves, for exact post-processing.
+  const int vrows = d.v_hi() - lo;
+  std::vector<double> uf(std::size_t(nx + 1) * rows), vf(std::size_t(nx) * vrows);
+  for (int j = lo; j < d.hi(); ++j)
+    for (int i = 0; i <= nx; ++i) uf[i + std::size_t(nx + 1) * (j - lo)] = s.u()(i, j);
+  for (int j = lo; j < d.v_hi(); ++j)
+    for (int i = 0; i < nx; ++i) vf[i + std::size_t(nx) * (j - lo)] = s.v()(i, j);
+  write(grp + "/u_face", uf, nx + 1, 0, {std::size_t(ny), std::size_t(nx + 1)});
+  write(grp + "/v_face", vf, nx, 1, {std::size_t(ny + 1), std::size_t(nx)});
+  for (Side side : m_cfg.wall_shear) {
+    const std::vector<double> tau = wall_shear(s, side);
+    if (root) m_h5->write(fmt::format("{}/tau_{}", grp, kSideNames[side]), tau);
+  }
+  if (!root) return;
   std::vector<fsi::XdmfAttribute> at;
   for (const char* q : {"u", "v", "p", "vorticity"}) {
     at.push_back({q, fsi::XdmfCenter::cell, grp + "/" + q, 1});
@@ -181,14 +210,14 @@ void FluidProgram::write_fields(long step, double t) {
 }
 
 void FluidProgram::output(long step, double t, bool fields) {
-  if (m_probes) {
+  if (!m_cfg.probes.empty()) {
     for (std::size_t k = 0; k < m_cfg.probes.size(); ++k) {
       const auto& at = m_cfg.probes[k].at;
       for (int q = 0; q < 3; ++q) m_row[3 * k + q] = sample(*m_solver, q, at[0], at[1]);
     }
-    m_probes->write(t, m_row);
+    if (m_probes) m_probes->write(t, m_row);
   }
-  if (m_flow) write_flow_rate(t);
+  if (!m_flow_columns.empty()) write_flow_rate(t);
   if (fields) write_fields(step, t);
 }
 
@@ -196,6 +225,7 @@ void FluidProgram::output(long step, double t, bool fields) {
 void FluidProgram::write_flow_rate(double t) {
   for (std::size_t k = 0; k < m_flow_columns.size(); ++k)
     m_flow_row[k] = flow_rate(*m_solver, m_flow_columns[k]);
+  if (!m_flow) return;  // not rank 0
   m_flow->write(t, m_flow_row);
   m_flow_times.push_back(t);
   m_flow_values.insert(m_flow_values.end(), m_flow_row.begin(), m_flow_row.end());
@@ -240,6 +270,10 @@ nlohmann::json FluidProgram::flow_rate_report() const {
 
 // The solver's state, and the health check's (the diagnostics the coupler is sent).
 void FluidProgram::save(fsi::H5File& h5) const {
+  if (m_rt.program_size() > 1)
+    fsi::fail("the fluid on {} ranks writes no checkpoints yet (a stop asked for one); the "
+              "output written so far is kept",
+              m_rt.program_size());
   m_solver->save(h5);
   h5.write("health", std::vector<double>{m_cfl, m_div, m_div_first, m_energy});
 }

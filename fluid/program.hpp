@@ -38,7 +38,7 @@ class FluidProgram : public fsi::FluidPort {
   fsi::Runtime& m_rt;
   Config m_cfg;
   std::unique_ptr<Solver> m_solver;
-  fsi::H5File m_h5;
+  std::optional<fsi::H5File> m_h5;  // the files: on the fluid's rank 0 only
   std::optional<fsi::XdmfWriter> m_xdmf;
   std::optional<fsi::ProbeCsv> m_probes;
   std::vector<double> m_row, m_w1, m_w2;

@@ -13,24 +13,31 @@ namespace fluid {
 // the solver's operator holds the phi_0 part, -2 phi_b / w_0^2 moves to the right-hand side.
 void Solver::project(double dt, double t_new) {
   const int nx = m_grid.nx(), ny = m_grid.ny();
+  const int lo = row_lo(), hi = row_hi();
   const double *xwi = m_grid.x().wi(), *ywi = m_grid.y().wi();
   const double *xdi = m_grid.x().di(), *ydi = m_grid.y().di();
-  FastSolver& ps = *m_poisson;
-  double* buf = ps.data();
-  const int nt = ps.nt();
+  double* buf = solve_data(2);
+  const int nt = solve_nt(2);
   const double k = m_cfg.density / dt;
-  // The duplicate face of a periodic direction carries the value of face 0.
+  // The duplicate face of a periodic direction carries the value of face 0. On several ranks
+  // the v faces above the slab (row hi) come from the neighbour, which also covers a periodic y.
   if (m_grid.x().periodic())
-    for (int j = 0; j < ny; ++j) m_u(nx, j) = m_u(0, j);
-  if (m_grid.y().periodic())
-    for (int i = 0; i < nx; ++i) m_v(i, ny) = m_v(i, 0);
-  for (int j = 0; j < ny; ++j) {
+    for (int j = lo; j < hi; ++j) m_u(nx, j) = m_u(0, j);
+  if (m_dec.serial()) {
+    if (m_grid.y().periodic())
+      for (int i = 0; i < nx; ++i) m_v(i, ny) = m_v(i, 0);
+  } else {
+    m_dec.halo(m_v);
+  }
+  // The right-hand side in the solver's layout: rows of x (FastSolver along x, or any slab).
+  const bool by_rows = m_t_axis == 0 || !m_dec.serial();
+  for (int j = lo; j < hi; ++j) {
     const double* u = m_u.row(j);
     const double* v = m_v.row(j);
     const double* vn = m_v.row(j + 1);
     const double wy = ywi[j];
-    if (m_t_axis == 0) {
-      double* b = buf + std::size_t(nt) * j;
+    if (by_rows) {
+      double* b = buf + std::size_t(nt) * (j - lo);
       for (int i = 0; i < nx; ++i) b[i] = k * ((u[i + 1] - u[i]) * xwi[i] + (vn[i] - v[i]) * wy);
     } else {
       for (int i = 0; i < nx; ++i) {
@@ -45,17 +52,17 @@ void Solver::project(double dt, double t_new) {
     if (!m_bnd.is_pressure(s)) continue;
     const int i = s == left ? 0 : nx - 1, g = s == left ? -1 : nx;
     const double coef = 2.0 * xwi[i] * xwi[i];
-    for (int j = 0; j < ny; ++j) {
+    for (int j = lo; j < hi; ++j) {
       m_phi_b[s][j] = m_face_p[s][j] - 0.5 * (m_p(g, j) + m_p(i, j));
       buf[buf_index(i, j, 0, 0, nt)] -= coef * m_phi_b[s][j];
     }
   }
   {
     const PhaseTimer t(m_time.poisson);
-    ps.solve();
+    solve(2);
   }
   const PhaseTimer t(m_time.projection);
-  for (int j = 0; j < ny; ++j) {
+  for (int j = lo; j < hi; ++j) {
     double* phi = m_phi.row(j);
     double* p = m_p.row(j);
     for (int i = 0; i < nx; ++i) {
@@ -66,12 +73,12 @@ void Solver::project(double dt, double t_new) {
   m_bnd.fill_scalar(m_phi, m_phi_b);
   m_bnd.fill_scalar(m_p, m_face_p);
   const double c = dt / m_cfg.density;
-  for (int j = 0; j < ny; ++j) {
+  for (int j = lo; j < hi; ++j) {
     double* u = m_u.row(j);
     const double* phi = m_phi.row(j);
     for (int i = m_iu0; i < m_iu1; ++i) u[i] -= c * (phi[i] - phi[i - 1]) * xdi[i];
   }
-  for (int j = m_j0; j < ny; ++j) {
+  for (int j = v_row_lo(); j < hi; ++j) {
     double* v = m_v.row(j);
     const double* phi = m_phi.row(j);
     const double* phs = m_phi.row(j - 1);

@@ -91,7 +91,7 @@ Operator1D make_operator(const Axis& ax, Loc loc, bool transform, const Boundari
 
 }  // namespace
 
-Solver::Solver(const Config& c, double dt)
+Solver::Solver(const Config& c, double dt, MPI_Comm comm)
     : m_cfg(c),
       m_grid(
           [&] {
@@ -104,7 +104,8 @@ Solver::Solver(const Config& c, double dt)
             y.periodic = c.bc[bottom].type == BcType::periodic;
             return y;
           }()),
-      m_bnd(m_grid, c.bc),
+      m_dec(comm, m_grid.ny(), m_grid.y().periodic()),
+      m_bnd(m_grid, c.bc, m_dec),
       m_sponge(sponge_weights(m_grid, c.upwind_blend)) {
   validate(c, dt);
   m_nu = c.viscosity / c.density;
@@ -114,25 +115,31 @@ Solver::Solver(const Config& c, double dt)
   m_j0 = m_grid.y().periodic() ? 0 : 1;
   m_iu0 = m_bnd.is_pressure(left) ? 0 : m_i0;
   m_iu1 = m_bnd.is_pressure(right) ? nx + 1 : nx;
-  m_u = Field(nx + 1, ny);
-  m_v = Field(nx, ny + 1);
-  m_p = Field(nx, ny);
-  m_phi = Field(nx, ny);
-  m_hu = m_hu_old = Field(nx + 1, ny);
-  m_hv = m_hv_old = Field(nx, ny + 1);
+  const int lo = m_dec.lo(), hi = m_dec.hi(), vhi = m_dec.v_hi();
+  m_u = Field(nx + 1, ny, lo, hi);
+  m_v = Field(nx, ny + 1, lo, vhi);
+  m_p = Field(nx, ny, lo, hi);
+  m_phi = Field(nx, ny, lo, hi);
+  m_hu = m_hu_old = Field(nx + 1, ny, lo, hi);
+  m_hv = m_hv_old = Field(nx, ny + 1, lo, vhi);
 
   const Axis& T = m_grid.axis(m_t_axis);
   const Axis& S = m_grid.axis(1 - m_t_axis);
   const int side_t = 2 * m_t_axis, side_s = 2 * (1 - m_t_axis);
-  m_poisson =
-      std::make_unique<FastSolver>(make_operator(T, Loc::pressure, true, m_bnd, side_t),
-                                   make_operator(S, Loc::pressure, false, m_bnd, side_s), 0.0);
+  const Operator1D pt = make_operator(T, Loc::pressure, true, m_bnd, side_t);
+  const Operator1D ps = make_operator(S, Loc::pressure, false, m_bnd, side_s);
   std::vector<double> w(S.n());
   for (int j = 0; j < S.n(); ++j) w[j] = S.width(j);
-  m_poisson->set_mean_weights(w);
+  if (m_dec.serial()) {
+    m_poisson = std::make_unique<FastSolver>(pt, ps, 0.0);
+    m_poisson->set_mean_weights(w);
+  } else {
+    m_slab_poisson = std::make_unique<SlabSolver>(pt, ps, 0.0, m_t_axis, ny, 0, comm);
+    m_slab_poisson->set_mean_weights(w);
+  }
   if (c.implicit) {
-    m_lu = Field(nx + 1, ny);
-    m_lv = Field(nx, ny + 1);
+    m_lu = Field(nx + 1, ny, lo, hi);
+    m_lv = Field(nx, ny + 1, lo, vhi);
     build_implicit(dt);
   }
   m_bnd.fill_ghosts(m_u, m_v);
@@ -147,7 +154,7 @@ Solver::~Solver() = default;
 // p_b(t) per row; with `total`, p_b(t) - rho u^2 / 2 on the rows where u enters (u > 0 on the
 // left face, u < 0 on the right), u the face's current normal velocity.
 void Solver::face_pressure(double t) {
-  const int nx = m_grid.nx(), ny = m_grid.ny();
+  const int nx = m_grid.nx();
   for (int s : {int(left), int(right)}) {
     if (!m_bnd.is_pressure(s)) continue;
     const SideBc& b = m_bnd.side(s);
@@ -155,7 +162,7 @@ void Solver::face_pressure(double t) {
     const int i = s == left ? 0 : nx;
     const double inward = s == left ? 1.0 : -1.0;
     std::vector<double>& v = m_face_p[s];
-    for (int j = 0; j < ny; ++j) {
+    for (int j = row_lo(); j < row_hi(); ++j) {
       const double un = inward * m_u(i, j);
       v[j] = b.total && un > 0 ? pb - 0.5 * m_cfg.density * un * un : pb;
     }
@@ -171,9 +178,16 @@ void Solver::build_implicit(double dt) {
   for (int comp = 0; comp < 2; ++comp) {
     const Loc lt = comp == m_t_axis ? Loc::normal : Loc::tangential;
     const Loc ls = comp == m_t_axis ? Loc::tangential : Loc::normal;
-    auto solver = std::make_unique<FastSolver>(make_operator(T, lt, true, m_bnd, side_t),
-                                               make_operator(S, ls, false, m_bnd, side_s), sigma);
-    (comp == 0 ? m_helm_u : m_helm_v) = std::move(solver);
+    const Operator1D ot = make_operator(T, lt, true, m_bnd, side_t);
+    const Operator1D os = make_operator(S, ls, false, m_bnd, side_s);
+    if (m_dec.serial()) {
+      (comp == 0 ? m_helm_u : m_helm_v) = std::make_unique<FastSolver>(ot, os, sigma);
+    } else {
+      // The v faces between walls have one unknown row fewer than the cells: a padded row 0.
+      const int pad = comp == 1 ? m_j0 : 0;
+      (comp == 0 ? m_slab_u : m_slab_v) = std::make_unique<SlabSolver>(
+          ot, os, sigma, m_t_axis, m_grid.ny(), pad, m_dec.comm());
+    }
   }
   m_dt_implicit = dt;
 }
@@ -186,6 +200,30 @@ std::array<double, 2> Solver::body_acceleration(double t) const {
     a[d] = (m_cfg.body[d] + m_cfg.oscillating[d] * s) / m_cfg.density + m_cfg.gravity[d];
   }
   return a;
+}
+
+double* Solver::solve_data(int which) {
+  if (m_dec.serial()) return (which == 0 ? *m_helm_u : which == 1 ? *m_helm_v : *m_poisson).data();
+  return (which == 0 ? *m_slab_u : which == 1 ? *m_slab_v : *m_slab_poisson).data();
+}
+
+int Solver::solve_nt(int which) const {
+  if (m_dec.serial()) return (which == 0 ? *m_helm_u : which == 1 ? *m_helm_v : *m_poisson).nt();
+  return (which == 0 ? *m_slab_u : which == 1 ? *m_slab_v : *m_slab_poisson).row_length();
+}
+
+std::size_t Solver::solve_size(int which) const {
+  if (m_dec.serial()) {
+    const FastSolver& f = which == 0 ? *m_helm_u : which == 1 ? *m_helm_v : *m_poisson;
+    return std::size_t(f.nt()) * f.ns();
+  }
+  const SlabSolver& f = which == 0 ? *m_slab_u : which == 1 ? *m_slab_v : *m_slab_poisson;
+  return std::size_t(f.row_length()) * (f.split().hi - f.split().lo);
+}
+
+void Solver::solve(int which) {
+  if (m_dec.serial()) return (which == 0 ? *m_helm_u : which == 1 ? *m_helm_v : *m_poisson).solve();
+  (which == 0 ? *m_slab_u : which == 1 ? *m_slab_v : *m_slab_poisson).solve();
 }
 
 void Solver::step(double dt) {
@@ -300,18 +338,25 @@ void Solver::sample(const CouplingIn& in, CouplingOut& out) const {
   out.sample_p.resize(in.sample_p_index.size());
   for (std::size_t q = 0; q < in.sample_p_index.size(); ++q) {
     const std::int32_t c = in.sample_p_index[q];
-    out.sample_p[q] = m_p(c % m_grid.nx(), c / m_grid.nx());
+    out.sample_p[q] = m_p(c % m_grid.nx(), owned(c / m_grid.nx(), 2));
   }
   out.sample_u.resize(in.sample_u_index.size());
   out.sample_v.resize(in.sample_v_index.size());
   for (std::size_t q = 0; q < in.sample_u_index.size(); ++q) {
     const auto [i, j] = face_of(0, in.sample_u_index[q]);
-    out.sample_u[q] = m_u(i, j);
+    out.sample_u[q] = m_u(i, owned(j, 0));
   }
   for (std::size_t q = 0; q < in.sample_v_index.size(); ++q) {
     const auto [i, j] = face_of(1, in.sample_v_index[q]);
-    out.sample_v[q] = m_v(i, j);
+    out.sample_v[q] = m_v(i, owned(j, 1));
   }
+}
+
+int Solver::owned(int j, int comp) const {
+  if (m_dec.serial() || (comp == 1 ? m_dec.owns_v_row(j) : m_dec.owns_row(j))) return j;
+  fsi::fail("fluid rank {}: the coupling input names a face or cell of row {}, which rank {} holds "
+            "(this rank holds rows [{}, {}))",
+            m_dec.rank(), j, m_dec.owner(j), m_dec.lo(), comp == 1 ? m_dec.v_hi() : m_dec.hi());
 }
 
 }  // namespace fluid

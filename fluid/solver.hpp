@@ -6,6 +6,7 @@
 // solve, correct.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -14,10 +15,12 @@
 
 #include "boundary.hpp"
 #include "config.hpp"
+#include "decomposition.hpp"
 #include "fast_solver.hpp"
 #include "field.hpp"
 #include "grid.hpp"
 #include "momentum.hpp"
+#include "slab_solver.hpp"
 
 namespace fluid {
 
@@ -62,12 +65,16 @@ struct Timings {
 class Solver {
  public:
   // dt: the time step the implicit operators are built for (they are rebuilt if it changes).
-  Solver(const Config& c, double dt);
+  // comm: the ranks the grid is split over in slabs of rows (decomposition.hpp); MPI_COMM_NULL
+  // or one rank: the whole grid here, without MPI. On several ranks the fields hold this rank's
+  // rows, and the coupling input names faces of those rows only.
+  Solver(const Config& c, double dt, MPI_Comm comm = MPI_COMM_NULL);
   ~Solver();
 
   const Config& config() const { return m_cfg; }
   const Grid& grid() const { return m_grid; }
   const Boundaries& boundaries() const { return m_bnd; }
+  const Decomposition& decomposition() const { return m_dec; }
   double time() const { return m_t; }
   long step_count() const { return m_step; }
   // Axis whose direction the fast solver transforms (0 = x, 1 = y).
@@ -114,7 +121,7 @@ class Solver {
   void reset_timings() { m_time = {}; }
   // Acceleration of the body force at time t (force per unit volume / rho + g).
   std::array<double, 2> body_acceleration(double t) const;
-  // The bare Poisson solver (for the benchmark's floor and tests).
+  // The bare Poisson solver (for the benchmark's floor and tests; on one rank).
   FastSolver& poisson() { return *m_poisson; }
 
  private:
@@ -137,17 +144,32 @@ class Solver {
   void restore_predictor();                                                  // solver.cpp
   void correct(double dt, const CouplingIn& in, CouplingOut& out);           // solver.cpp
   void sample(const CouplingIn& in, CouplingOut& out) const;                 // solver.cpp
+  // j, when this rank holds row j of u or p (comp 0, 2) or of v (1); else a clear error.
+  int owned(int j, int comp) const;                                          // solver.cpp
   // (i, j) of the face with the coupling index idx, of u (comp 0) or v (comp 1).
   std::array<int, 2> face_of(int comp, std::int32_t idx) const {
     const int w = comp == 0 ? m_grid.nu() : m_grid.nx();
     return {int(idx % w), int(idx / w)};
   }
+  // Index of unknown (i, j) in a direct solver's data: FastSolver's t-fastest layout (nt: its
+  // t count), or on several ranks the slab's rows (nt: the row length, x unknowns).
   int buf_index(int i, int j, int i_first, int j_first, int nt) const {
+    if (!m_dec.serial()) return (i - i_first) + nt * (j - m_dec.lo());
     return m_t_axis == 0 ? (i - i_first) + nt * (j - j_first) : (j - j_first) + nt * (i - i_first);
   }
+  // The direct solvers, whichever kind: 0 = u, 1 = v (Helmholtz), 2 = pressure (Poisson).
+  double* solve_data(int which);
+  int solve_nt(int which) const;
+  std::size_t solve_size(int which) const;  // values in solve_data() on this rank
+  void solve(int which);
+  // First row of this rank's u, p rows and of its v unknowns (j0 or lo).
+  int row_lo() const { return m_dec.lo(); }
+  int row_hi() const { return m_dec.hi(); }
+  int v_row_lo() const { return std::max(m_j0, m_dec.lo()); }
 
   Config m_cfg;
   Grid m_grid;
+  Decomposition m_dec;
   Boundaries m_bnd;
   SpongeWeights m_sponge;
   int m_t_axis = 0;
@@ -170,6 +192,7 @@ class Solver {
   Phase m_phase = Phase::between_steps;
   double m_begun_dt = 0;  // dt of the step begin_step() began
   std::unique_ptr<FastSolver> m_poisson, m_helm_u, m_helm_v;
+  std::unique_ptr<SlabSolver> m_slab_poisson, m_slab_u, m_slab_v;  // on several ranks
   // Crank-Nicolson: the step's right-hand side B (scaled), per component, in the Helmholtz
   // solver's layout (predictor_implicit), until its solve.
   std::array<std::vector<double>, 2> m_rhs;

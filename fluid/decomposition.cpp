@@ -1,0 +1,96 @@
+// Halo exchanges, reductions and gathers of the row slabs (decomposition.hpp).
+#include "decomposition.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "error.hpp"
+#include "slab_solver.hpp"
+
+namespace fluid {
+
+Decomposition::Decomposition(MPI_Comm comm, int ny, bool periodic_y)
+    : m_comm(comm), m_ny(ny), m_lo(0), m_hi(ny), m_block(ny), m_periodic(periodic_y) {
+  if (comm == MPI_COMM_NULL) return;
+  MPI_Comm_size(comm, &m_ranks);
+  MPI_Comm_rank(comm, &m_rank);
+  if (m_ranks == 1) return;
+  const RowSplit s = split_rows(ny, m_ranks, m_rank);
+  m_lo = s.lo, m_hi = s.hi, m_block = s.block;
+  // The wall ghosts of u use the first two rows; a stencil reads one row beyond the slab.
+  const int last = ny - s.lo_of(m_ranks - 1);
+  if (last < 2)
+    throw fsi::InputError(fmt::format(
+        "the fluid's {} cell rows over {} ranks leave the last rank {} row(s) (blocks of {}); each "
+        "rank needs at least 2: use fewer ranks",
+        ny, m_ranks, last, s.block));
+}
+
+int Decomposition::owner(int j) const {
+  if (m_ranks == 1) return 0;
+  return std::clamp(std::clamp(j, 0, m_ny - 1) / m_block, 0, m_ranks - 1);
+}
+
+void Decomposition::halo(Field& f) const {
+  if (m_ranks == 1) return;
+  const bool first = m_rank == 0, last = m_rank == m_ranks - 1;
+  const int down = first ? (m_periodic ? m_ranks - 1 : MPI_PROC_NULL) : m_rank - 1;
+  const int up = last ? (m_periodic ? 0 : MPI_PROC_NULL) : m_rank + 1;
+  const int n = f.sx;
+  // Row lo down (the lower neighbour's row hi), row hi up from it; row hi - 1 up, row lo - 1 in.
+  MPI_Sendrecv(f.row(m_lo) - 1, n, MPI_DOUBLE, down, 7301, f.row(m_hi) - 1, n, MPI_DOUBLE, up,
+               7301, m_comm, MPI_STATUS_IGNORE);
+  MPI_Sendrecv(f.row(m_hi - 1) - 1, n, MPI_DOUBLE, up, 7302, f.row(m_lo - 1) - 1, n, MPI_DOUBLE,
+               down, 7302, m_comm, MPI_STATUS_IGNORE);
+}
+
+double Decomposition::sum(double x) const {
+  if (m_ranks == 1) return x;
+  double s = 0;
+  MPI_Allreduce(&x, &s, 1, MPI_DOUBLE, MPI_SUM, m_comm);
+  return s;
+}
+
+void Decomposition::sum(double* x, int n) const {
+  if (m_ranks == 1) return;
+  MPI_Allreduce(MPI_IN_PLACE, x, n, MPI_DOUBLE, MPI_SUM, m_comm);
+}
+
+int Decomposition::argmax(double x) const {
+  if (m_ranks == 1) return 0;
+  struct {
+    double value;
+    int rank;
+  } in{std::isnan(x) ? std::numeric_limits<double>::infinity() : x, m_rank}, out{};
+  MPI_Allreduce(&in, &out, 1, MPI_DOUBLE_INT, MPI_MAXLOC, m_comm);
+  return out.rank;
+}
+
+void Decomposition::broadcast(void* x, int bytes, int root) const {
+  if (m_ranks == 1) return;
+  MPI_Bcast(x, bytes, MPI_BYTE, root, m_comm);
+}
+
+void Decomposition::gather_rows(const double* local, int n_per_row, int local_rows, double* all,
+                                int extra_last_rows) const {
+  if (m_ranks == 1) {
+    std::copy(local, local + std::size_t(n_per_row) * local_rows, all);
+    return;
+  }
+  std::vector<int> counts(m_ranks), displs(m_ranks);
+  const RowSplit s = split_rows(m_ny, m_ranks, m_rank);
+  for (int r = 0; r < m_ranks; ++r) {
+    const int rows = s.hi_of(r) - s.lo_of(r) + (r == m_ranks - 1 ? extra_last_rows : 0);
+    counts[r] = rows * n_per_row;
+    displs[r] = s.lo_of(r) * n_per_row;
+  }
+  if (local_rows * n_per_row != counts[m_rank])
+    fsi::fail("fluid::Decomposition::gather_rows: {} rows given, {} expected", local_rows,
+              counts[m_rank] / std::max(1, n_per_row));
+  MPI_Gatherv(local, counts[m_rank], MPI_DOUBLE, all, counts.data(), displs.data(), MPI_DOUBLE, 0,
+              m_comm);
+}
+
+}  // namespace fluid

@@ -1,0 +1,61 @@
+// The fluid's grid split over ranks in slabs of cell rows (y), FFTW's block split (see
+// slab_solver.hpp): rank r holds cell rows [lo, hi), u and p rows [lo, hi), v rows [lo, hi) and
+// on the last rank also the top boundary face ny. Every field keeps one ghost row on each side,
+// filled from the neighbours by halo(); with a periodic y the first and last ranks are
+// neighbours. On one rank (the default) nothing here calls MPI: the solver is the serial one.
+#pragma once
+
+#include <mpi.h>
+
+#include <array>
+
+#include "field.hpp"
+
+namespace fluid {
+
+class Decomposition {
+ public:
+  Decomposition() = default;  // one rank, the whole grid
+  // Rows of a grid of ny cell rows split over the ranks of comm (MPI_COMM_NULL: one rank).
+  // Throws fsi::InputError when a rank would hold fewer than two rows.
+  Decomposition(MPI_Comm comm, int ny, bool periodic_y);
+
+  bool serial() const { return m_ranks == 1; }
+  int rank() const { return m_rank; }
+  int ranks() const { return m_ranks; }
+  MPI_Comm comm() const { return m_comm; }
+  int lo() const { return m_lo; }
+  int hi() const { return m_hi; }
+  // The rank whose cell rows hold row j (j clamped to the grid's rows).
+  int owner(int j) const;
+  bool has_bottom() const { return m_rank == 0; }
+  bool has_top() const { return m_rank == m_ranks - 1; }
+  // Rows a field stores besides its ghosts: cell-row fields [lo, hi); the v faces [lo, v_hi()).
+  int v_hi() const { return has_top() ? m_ny + 1 : m_hi; }
+  bool owns_row(int j) const { return j >= m_lo && j < m_hi; }
+  bool owns_v_row(int j) const { return j >= m_lo && j < v_hi(); }
+
+  // The ghost rows lo - 1 and hi of f from the neighbours (the whole stored rows, ghost columns
+  // included). Collective.
+  void halo(Field& f) const;
+  // Sums and maxima over the ranks (collective; on one rank the value itself).
+  double sum(double x) const;
+  void sum(double* x, int n) const;
+  // The rank holding the largest value (NaN counts as larger than every number; ties: the
+  // lowest rank). Collective.
+  int argmax(double x) const;
+  // The bytes of `x` from rank `root` to every rank. Collective.
+  void broadcast(void* x, int bytes, int root) const;
+  // Each rank's rows [lo, hi) of `n_per_row` values (row-major; the last rank's with
+  // `extra_last_rows` more, e.g. the top v faces) gathered on rank 0 into `all`, in row order.
+  // Collective.
+  void gather_rows(const double* local, int n_per_row, int local_rows, double* all,
+                   int extra_last_rows = 0) const;
+
+ private:
+  MPI_Comm m_comm = MPI_COMM_NULL;
+  int m_rank = 0, m_ranks = 1, m_ny = 0, m_lo = 0, m_hi = 0, m_block = 0;
+  bool m_periodic = false;
+};
+
+}  // namespace fluid

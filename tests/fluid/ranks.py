@@ -1,0 +1,89 @@
+#!/usr/bin/python3
+"""Run fluid-only scenes on 1 rank and on P ranks and check that the outputs agree to round-off.
+
+  ranks.py --bin BIN --work DIR --ranks P [--tolerance 1e-12] -- MPIEXEC... SCENE.toml...
+
+Every scene runs as `MPIEXEC -n 1 BIN/fluid SCENE` and `MPIEXEC -n P BIN/fluid SCENE`. Compared:
+every numeric dataset of fluid.h5 and every column of the CSV files, each as the largest
+difference relative to the dataset's largest magnitude; the run fails when one exceeds the
+tolerance, or when a run fails. Prints the largest relative difference per dataset kind.
+"""
+import argparse
+import glob
+import os
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+
+def run(mpiexec, fluid, ranks, scene, out):
+    cmd = list(mpiexec) + ["-n", str(ranks), fluid, scene, "--out-dir", out, "--overwrite"]
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    if r.returncode != 0:
+        sys.exit(f"ranks: {scene} on {ranks} rank(s) failed (exit {r.returncode}):\n{r.stderr[-2000:]}")
+
+
+def datasets(path):
+    out = {}
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda name, obj: out.__setitem__(name, obj[()])
+                     if isinstance(obj, h5py.Dataset) and obj.dtype.kind == "f" else None)
+    return out
+
+
+def relative(a, b):
+    if a.shape != b.shape:
+        return np.inf
+    scale = np.max(np.abs(a)) if a.size else 0.0
+    d = np.max(np.abs(a - b)) if a.size else 0.0
+    return 0.0 if d == 0 else d / max(scale, 1e-300)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--bin", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--ranks", type=int, required=True)
+    ap.add_argument("--tolerance", type=float, default=1e-12)
+    ap.add_argument("rest", nargs=argparse.REMAINDER)
+    a = ap.parse_args()
+    rest = a.rest[1:] if a.rest and a.rest[0] == "--" else a.rest
+    scenes = [x for x in rest if x.endswith(".toml")]
+    mpiexec = [x for x in rest if not x.endswith(".toml")]
+    if not scenes or not mpiexec:
+        sys.exit("ranks: give the mpiexec command and at least one scene after --")
+    fluid = os.path.join(a.bin, "fluid")
+    worst_all, failures = 0.0, []
+    for scene in scenes:
+        name = os.path.splitext(os.path.basename(scene))[0]
+        one, many = (os.path.join(a.work, f"{name}-{p}") for p in (1, a.ranks))
+        run(mpiexec, fluid, 1, scene, one)
+        run(mpiexec, fluid, a.ranks, scene, many)
+        d1, dp = datasets(os.path.join(one, "fluid.h5")), datasets(os.path.join(many, "fluid.h5"))
+        if sorted(d1) != sorted(dp):
+            failures.append(f"{name}: the runs wrote different datasets")
+            continue
+        kinds = {}
+        for key in d1:
+            kind = key.split("/")[-1]
+            kinds[kind] = max(kinds.get(kind, 0.0), relative(d1[key], dp[key]))
+        for csv in sorted(glob.glob(os.path.join(one, "*.csv"))):
+            x = np.loadtxt(csv, delimiter=",", skiprows=1, ndmin=2)
+            y = np.loadtxt(os.path.join(many, os.path.basename(csv)), delimiter=",", skiprows=1, ndmin=2)
+            kinds[os.path.basename(csv)] = relative(x, y)
+        if not kinds:
+            failures.append(f"{name}: nothing compared")
+        for kind, d in sorted(kinds.items()):
+            print(f"{name}: {kind:24s} largest relative difference {d:.3g}")
+            worst_all = max(worst_all, d)
+            if not d <= a.tolerance:
+                failures.append(f"{name}: {kind} differs by {d:.3g} (tolerance {a.tolerance:g})")
+    print(f"largest relative difference, 1 against {a.ranks} ranks: {worst_all:.3g}")
+    if failures:
+        sys.exit("ranks: " + "; ".join(failures))
+
+
+if __name__ == "__main__":
+    main()
