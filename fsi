@@ -25,6 +25,8 @@ usage: ./fsi COMMAND [ARGS]
                               mpirun job of the programs it needs; output in out/<scene name>/
       [--time-limit SECONDS]  checkpoint and stop after this wall time
       [--restart OUTDIR]      resume the run in OUTDIR from its newest complete checkpoint
+      [--fluid-ranks P]       the fluid on P ranks (its grid split in row slabs; overrides
+                              [fluid] ranks)
   test [CTEST ARGS]           build, then run the whole test suite through CTest
   test --debug [CTEST ARGS]   the same in a Debug build (build-debug/: internal assertions and
                               bounds-checked field access on); unit and integration tests
@@ -101,6 +103,7 @@ plan() {
   ROLES=$(sed -n 's/^roles: //p' <<<"$out")
   PROGRAMS=$(sed -n 's/^programs: //p' <<<"$out")
   NAME=$(sed -n 's/^name: //p' <<<"$out")
+  FLUID_RANKS=${FLUID_RANKS_OPTION:-$(sed -n 's/^fluid_ranks: //p' <<<"$out")}
 }
 
 # compose SCENE ARGS...: the mpirun command line, one app context per program the scene needs.
@@ -111,7 +114,9 @@ compose() {
   local first=1
   for r in $PROGRAMS; do
     [ $first -eq 1 ] || CMD+=(:)
-    CMD+=(-n 1 "$BIN/$r" "$scene" "$@")
+    local n=1
+    [ "$r" = fluid ] && n=${FLUID_RANKS:-1}
+    CMD+=(-n "$n" "$BIN/$r" "$scene" "$@")
     first=0
   done
 }
@@ -125,6 +130,9 @@ run() {
                  restart=$2; shift ;;
       --time-limit) [ $# -ge 2 ] || die "--time-limit needs a number of seconds"
                     limit=(--time-limit "$2"); shift ;;
+      --fluid-ranks) [[ $# -ge 2 && "$2" =~ ^[1-9][0-9]*$ ]] \
+                       || die "--fluid-ranks needs a positive whole number of ranks, got '${2:-}'"
+                     FLUID_RANKS_OPTION=$2; shift ;;
       -*) die "unknown option '$1' for run (see ./fsi help)" ;;
       *) scene=$1 ;;
     esac

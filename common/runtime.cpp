@@ -337,7 +337,8 @@ std::filesystem::path choose_out_dir(const std::filesystem::path& root, const st
 
 void Link::send_bytes(std::size_t size, proto::Tag tag) {
   MPI_Request req;
-  MPI_Isend(m_out.data(), static_cast<int>(size), MPI_BYTE, 0, static_cast<int>(tag), m_comm, &req);
+  MPI_Isend(m_out.data(), static_cast<int>(size), MPI_BYTE, m_remote, static_cast<int>(tag), m_comm,
+            &req);
   wait_until(
       [&] {
         int done = 0;
@@ -355,7 +356,7 @@ std::size_t Link::recv_bytes(proto::Tag expected) {
   MPI_Status status;
   wait_until(
       [&] {
-        MPI_Improbe(0, MPI_ANY_TAG, m_comm, &flag, &msg, &status);
+        MPI_Improbe(m_remote, MPI_ANY_TAG, m_comm, &flag, &msg, &status);
         return flag != 0;
       },
       [&] { return fmt::format("message '{}' from {}", proto::tag_name(expected), role_name(m_peer)); },
@@ -375,13 +376,18 @@ std::size_t Link::recv_bytes(proto::Tag expected) {
 // ---- Runtime ----------------------------------------------------------------------------------
 
 Link& Runtime::coupler_link() {
-  if (!m_links[static_cast<int>(Role::coupler)]) fail("no coupler in this run");
-  return *m_links[static_cast<int>(Role::coupler)];
+  if (!has_link(Role::coupler)) fail("no coupler in this run");
+  return *m_links[static_cast<int>(Role::coupler)][0];
 }
 
 Link& Runtime::link(Role solver) {
-  if (!m_links[static_cast<int>(solver)]) fail("no link to the {}", role_name(solver));
-  return *m_links[static_cast<int>(solver)];
+  if (!has_link(solver)) fail("no link to the {}", role_name(solver));
+  return *m_links[static_cast<int>(solver)][0];
+}
+
+std::vector<std::unique_ptr<Link>>& Runtime::links(Role solver) {
+  if (!has_link(solver)) fail("no link to the {}", role_name(solver));
+  return m_links[static_cast<int>(solver)];
 }
 
 double Runtime::wall_seconds() const { return MPI_Wtime() - m_t0; }
@@ -457,14 +463,11 @@ void check_job(const Runtime& rt, const std::vector<Announce>& all, const RoleSe
            "program once",
            who, appnum[a.role], a.appnum);
     appnum[a.role] = a.appnum;
-    // The fluid may run on several ranks (a grid split in slabs), alone for now: the coupler
-    // talks to one fluid rank.
-    if (a.local_size != 1 && (a.role != static_cast<int>(Role::fluid) || need[Role::coupler]))
-      fail("{} was launched on {} ranks; {}", who, a.local_size,
-           a.role == static_cast<int>(Role::fluid)
-               ? "a coupled scene runs the fluid on 1 rank so far (-n 1 fluid); a fluid-only "
-                 "scene may run on several"
-               : "it runs on 1 rank (-n 1); only the fluid may run on several");
+    // The fluid may run on several ranks (its grid split in slabs); the others on one.
+    if (a.local_size != 1 && a.role != static_cast<int>(Role::fluid))
+      fail("{} was launched on {} ranks; it runs on 1 rank (-n 1); only the fluid may run on "
+           "several",
+           who, a.local_size);
   }
   std::vector<std::string> missing, launched;
   for (int r = 0; r < kRoleCount; ++r) {
@@ -603,13 +606,17 @@ int run_program(Role role, int argc, char** argv, const std::function<void(Runti
           MPI_Comm inter;
           MPI_Intercomm_create(local, 0, job, job_rank_of[static_cast<int>(s)],
                                kLinkTagBase + static_cast<int>(s), &inter);
-          rt.m_links[static_cast<int>(s)] = std::make_unique<Link>(inter, s);
+          int remote = 1;
+          MPI_Comm_remote_size(inter, &remote);
+          for (int r = 0; r < remote; ++r)
+            rt.m_links[static_cast<int>(s)].push_back(std::make_unique<Link>(inter, s, r));
         }
       } else {
         MPI_Comm inter;
         MPI_Intercomm_create(local, 0, job, job_rank_of[static_cast<int>(Role::coupler)],
                              kLinkTagBase + static_cast<int>(role), &inter);
-        rt.m_links[static_cast<int>(Role::coupler)] = std::make_unique<Link>(inter, Role::coupler);
+        rt.m_links[static_cast<int>(Role::coupler)].push_back(
+            std::make_unique<Link>(inter, Role::coupler));
       }
     }
 

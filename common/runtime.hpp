@@ -72,12 +72,13 @@ struct CommonSettings {
 };
 CommonSettings read_common(const SceneTable& root);
 
-// A point-to-point link to another program (an intercommunicator with one rank on each side).
+// A point-to-point link to one process of another program over their intercommunicator: its
+// rank `remote` there (0 unless that program runs on several ranks: the fluid's).
 // send/recv wait by testing and yielding the core between tests, so that a program waiting for a
 // message leaves the core to the one that computes.
 class Link {
  public:
-  Link(MPI_Comm inter, Role peer) : m_comm(inter), m_peer(peer) {}
+  Link(MPI_Comm inter, Role peer, int remote = 0) : m_comm(inter), m_peer(peer), m_remote(remote) {}
   Role peer() const { return m_peer; }
   // The first `size` bytes of m_out; a received message into m_in, returning its length.
   void send_bytes(std::size_t size, proto::Tag tag);
@@ -97,6 +98,7 @@ class Link {
  private:
   MPI_Comm m_comm;
   Role m_peer;
+  int m_remote = 0;
   std::uint64_t m_sent = 0, m_received = 0;
   // Kept between messages (see proto::Writer): a send completes before send() returns, and a
   // received message is unpacked before the next is received. Each keeps the size of the
@@ -116,9 +118,11 @@ class Runtime {
   // True when a coupler runs: solvers then talk to it through coupler_link().
   bool coupled() const { return m_roles[Role::coupler]; }
   Link& coupler_link();
-  // On the coupler: the link to a solver the scene needs.
+  // On the coupler: the link to a solver the scene needs (to its rank 0), and to each of its
+  // ranks (the fluid may run on several).
   Link& link(Role solver);
-  bool has_link(Role r) const { return m_links[static_cast<int>(r)] != nullptr; }
+  std::vector<std::unique_ptr<Link>>& links(Role solver);
+  bool has_link(Role r) const { return !m_links[static_cast<int>(r)].empty(); }
   double wall_seconds() const;  // since start
   // A restarted run: the step of the checkpoint it resumes from (nullopt: a fresh run).
   std::optional<long> restart_step() const { return m_restart_step; }
@@ -145,7 +149,7 @@ class Runtime {
   CommonSettings m_settings;
   RoleSet m_roles;
   std::filesystem::path m_out_dir;
-  std::array<std::unique_ptr<Link>, kRoleCount> m_links;
+  std::array<std::vector<std::unique_ptr<Link>>, kRoleCount> m_links;
   double m_t0 = 0;
   MPI_Comm m_program_comm = MPI_COMM_NULL;
   int m_program_rank = 0, m_program_size = 1;

@@ -85,7 +85,8 @@ void Coupler::begin_step(long n) {
       proto::StepBegin{n, fsi::step_time(s, n), s.dt, proto::Action::step, 0, iterates() ? 1 : 0};
   m_sb.checkpoint = m_stopping || fsi::is_checkpoint_step(s, n + 1);
   for (Role r : {Role::fluid, Role::fiber})
-    if (has(r)) m_rt.link(r).send(m_sb, n);
+    if (has(r))
+      for (auto& l : m_rt.links(r)) l->send(m_sb, n);
   m_rt.check_fault(n);
   m_start = m_solid;  // the bodies' state at t^n
   if (!iterates()) return;
@@ -124,7 +125,16 @@ void Coupler::begin_solid_step(long n) {
 // again from the same predictor ũ).
 void Coupler::fluid(long n) {
   if (m_surface && m_sb.iteration == 0) request_surface_samples();
-  if (has(Role::fluid)) exchange(Role::fluid, m_fluid_in, m_fluid_out, n);
+  if (!has(Role::fluid)) return;
+  if (!m_fluid_ranks) return exchange(Role::fluid, m_fluid_in, m_fluid_out, n);
+  // Several fluid ranks: each gets the part of the input on its rows; all answer.
+  m_phases.start("fluid");
+  m_fluid_ranks->split(m_fluid_in);
+  auto& links = m_rt.links(Role::fluid);
+  for (int r = 0; r < m_fluid_ranks->ranks(); ++r) links[r]->send(m_fluid_ranks->part(r), n);
+  for (int r = 0; r < m_fluid_ranks->ranks(); ++r) links[r]->recv(m_fluid_ranks->answer(r));
+  m_fluid_ranks->merge(m_fluid_out);
+  m_phases.stop("fluid");
 }
 
 // The nodal forces on the solid: the exact reaction of f_s (ImmersedSolid::reaction),
@@ -177,7 +187,8 @@ void Coupler::iterate(long n) {
     m_phases.stop("iterations");
     m_sb.iteration = k + 1;
     for (Role r : {Role::fluid, Role::solid})
-      if (has(r)) m_rt.link(r).send(m_sb, n);
+      if (has(r))
+        for (auto& l : m_rt.links(r)) l->send(m_sb, n);
     footprint();
     fluid(n);
     reaction();
@@ -309,13 +320,19 @@ void Coupler::finish(long steps, long first) {
   if (steps < s.steps) j["stopped_at_step"] = steps;
   for (Role r : {Role::fluid, Role::solid, Role::fiber}) {
     if (!has(r)) continue;
-    auto& l = m_rt.link(r);
-    l.send(stop, steps);
-    proto::Text report{proto::Tag::final_report, {}};
-    l.recv(report);
-    auto part = nlohmann::json::parse(report.text);
-    j["wall_time"][fsi::role_name(r)] = part["wall_time"];
-    j[fsi::role_name(r)] = part;
+    // Every rank of the solver is stopped and reports; its rank 0's report stands for it (the
+    // fluid's diagnostics are the whole grid's on every rank), with the count of ranks.
+    auto& links = m_rt.links(r);
+    for (auto& l : links) l->send(stop, steps);
+    for (std::size_t k = 0; k < links.size(); ++k) {
+      proto::Text report{proto::Tag::final_report, {}};
+      links[k]->recv(report);
+      if (k > 0) continue;
+      auto part = nlohmann::json::parse(report.text);
+      if (links.size() > 1) part["ranks"] = links.size();
+      j["wall_time"][fsi::role_name(r)] = part["wall_time"];
+      j[fsi::role_name(r)] = part;
+    }
   }
   const double loop = std::max(m_rt.wall_seconds() - m_t_start, kMinLoopSeconds);
   j["wall_time"]["coupler"] = m_rt.wall_seconds();

@@ -12,6 +12,7 @@
 
 #include "acceleration.hpp"
 #include "exchange_log.hpp"
+#include "fluid_ranks.hpp"
 #include "ib.hpp"
 #include "immersed.hpp"
 #include "probes.hpp"
@@ -122,6 +123,8 @@ class Coupler {
   proto::FiberState m_fiber;
   proto::FluidInput m_fluid_in;
   proto::FluidOutput m_fluid_out;
+  // The fluid on several ranks: the split of its input and the merge of its answers.
+  std::unique_ptr<FluidRanks> m_fluid_ranks;
   proto::SolidInput m_solid_in;
   proto::FiberInput m_fiber_in;
   std::map<std::string, std::string> m_effective;  // role -> its effective scene (TOML)

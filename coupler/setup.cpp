@@ -101,9 +101,18 @@ void Coupler::setup() {
     m_effective[role] = t.text;
   };
   if (has(Role::fluid)) {
-    auto& l = m_rt.link(Role::fluid);
-    l.recv(m_grid);
-    effective(l, "fluid");
+    // Every fluid rank sends the grid and its scene (the same); on several ranks the input of
+    // each step is split by their rows (fluid_ranks.hpp).
+    auto& links = m_rt.links(Role::fluid);
+    for (std::size_t k = 0; k < links.size(); ++k) {
+      proto::GridInfo g;
+      links[k]->recv(k == 0 ? m_grid : g);
+      if (k > 0 && (g.nx != m_grid.nx || g.ny != m_grid.ny))
+        fsi::fail("fluid rank {} sent a {} x {} grid, rank 0 a {} x {} grid", k, g.nx, g.ny,
+                  m_grid.nx, m_grid.ny);
+      effective(*links[k], "fluid");
+    }
+    if (links.size() > 1) m_fluid_ranks = std::make_unique<FluidRanks>(m_grid, int(links.size()));
   }
   if (has(Role::solid)) {
     auto& l = m_rt.link(Role::solid);

@@ -55,10 +55,24 @@ double Boundaries::inflow(int s, double coord, double t) const {
   return ramp * 6.0 * b.mean * e;  // parabola with mean `mean`: 1.5 mean y (H - y) / (H/2)^2
 }
 
+const std::vector<double>& Boundaries::whole_side(int s) const {
+  if (m_d.serial()) return m_mine;
+  if (s < 2) {
+    m_all.resize(m_g.ny());
+    m_d.gather_all_rows(m_mine.data(), m_all.data());
+  } else {
+    m_all = m_mine;
+    m_all.resize(m_g.nx());
+    m_d.broadcast(m_all.data(), int(m_all.size() * sizeof(double)),
+                  s == bottom ? 0 : m_d.ranks() - 1);
+  }
+  return m_all;
+}
+
 double Boundaries::net_inflow(const Field& u, const Field& v) const {
   double q = 0;
   for (int s = 0; s < 4; ++s) {
-    if (m_bc[s].type == BcType::periodic || !holds(s)) continue;
+    if (m_bc[s].type == BcType::periodic) continue;
     const int a = s / 2;
     const bool hi = s % 2;
     const Axis& ax = m_g.axis(a);
@@ -66,10 +80,12 @@ double Boundaries::net_inflow(const Field& u, const Field& v) const {
     const Field& f = a == 0 ? u : v;
     const int b = hi ? ax.n() : 0;
     const double sign = hi ? -1.0 : 1.0;
-    const int k0 = a == 0 ? row_lo() : 0, k1 = a == 0 ? row_hi() : o.n();
-    for (int k = k0; k < k1; ++k) q += sign * (a == 0 ? f(b, k) : f(k, b)) * o.width(k);
+    const int k0 = a == 0 ? row_lo() : 0, k1 = a == 0 ? row_hi() : holds(s) ? o.n() : 0;
+    m_mine.resize(k1 - k0);
+    for (int k = k0; k < k1; ++k) m_mine[k - k0] = sign * (a == 0 ? f(b, k) : f(k, b)) * o.width(k);
+    for (double t : whole_side(s)) q += t;
   }
-  return m_d.sum(q);
+  return q;
 }
 
 // Convective outflow: q_b^{n+1} = q_b^n - r (q_b^n - q_1^n), r = c dt / w, 0 <= r <= 1, with c the
@@ -101,17 +117,15 @@ void Boundaries::advance_normal(Field& u, Field& v, double t, double dt) {
     } else {  // outflow
       const int b1 = hi ? b - 1 : 1, b2 = hi ? b - 2 : 2;
       const double w = ax.width(hi ? ax.n() - 1 : 0);
-      double sums[2] = {0, 0};  // flux out, length
-      for (int k = k0; k < k1; ++k) {
-        sums[0] -= sign_in * at(nf, a, b, k) * o.width(k);
-        sums[1] += o.width(k);
-      }
-      m_d.sum(sums, 2);
-      const double flux = sums[0], len = sums[1];
+      double flux = 0, len = 0;
+      m_mine.resize(k1 - k0);
+      for (int k = k0; k < k1; ++k) m_mine[k - k0] = sign_in * at(nf, a, b, k) * o.width(k);
+      for (double t : whole_side(s)) flux -= t;
+      for (int k = 0; k < o.n(); ++k) len += o.width(k);
       const double r_bulk = std::clamp(flux / len * dt / w, 0.0, 1.0);
       std::vector<double>& prev = m_prev[s];
       const bool orlanski = bc.phase == Phase::orlanski && int(prev.size()) == k1 - k0;
-      double r_sum = 0;
+      m_mine.resize(k1 - k0);
       for (int k = k0; k < k1; ++k) {
         double r = r_bulk;
         const double q1 = at(nf, a, b1, k);
@@ -119,11 +133,12 @@ void Boundaries::advance_normal(Field& u, Field& v, double t, double dt) {
           const double den = q1 - at(nf, a, b2, k);
           r = den != 0.0 ? std::clamp(-(q1 - prev[k - k0]) / den, 0.0, 1.0) : 0.0;
         }
-        r_sum += r;
+        m_mine[k - k0] = r;
         double& qb = at(nf, a, b, k);
         qb -= r * (qb - q1);
       }
-      r_sum = m_d.sum(r_sum);
+      double r_sum = 0;
+      for (double r : whole_side(s)) r_sum += r;
       prev.resize(k1 - k0);
       for (int k = k0; k < k1; ++k) prev[k - k0] = at(nf, a, b1, k);
       // Tangential ghost, one cell width beyond the first interior value.

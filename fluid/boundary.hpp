@@ -71,6 +71,10 @@ class Boundaries {
   int row_lo() const { return m_d.lo(); }
   int row_hi() const { return m_d.hi(); }
   bool holds(int s) const { return s < 2 || (s == bottom ? m_d.has_bottom() : m_d.has_top()); }
+  // Per-position values along side s, given for this rank's positions in m_mine (its rows, or
+  // every column when it holds a bottom or top side), as the whole side's on every rank: sums
+  // over a side then run in the one-rank order, and give its bits on any number of ranks.
+  const std::vector<double>& whole_side(int s) const;
 
   const Grid& m_g;
   Decomposition m_d;
@@ -79,6 +83,7 @@ class Boundaries {
   bool m_has_outflow = false;
   std::array<std::vector<double>, 4> m_prev;  // Orlanski: last step's first interior line
   std::array<double, 4> m_speed{};            // walls: tangential speed at the last advance_normal
+  mutable std::vector<double> m_mine, m_all;  // whole_side()'s buffers
 };
 
 }  // namespace fluid

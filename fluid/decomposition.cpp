@@ -68,6 +68,20 @@ int Decomposition::argmax(double x) const {
   return out.rank;
 }
 
+void Decomposition::gather_all_rows(const double* mine, double* all) const {
+  if (m_ranks == 1) {
+    std::copy(mine, mine + m_ny, all);
+    return;
+  }
+  std::vector<int> counts(m_ranks), displs(m_ranks);
+  for (int r = 0; r < m_ranks; ++r) {
+    displs[r] = std::min(m_ny, r * m_block);
+    counts[r] = std::min(m_ny, (r + 1) * m_block) - displs[r];
+  }
+  MPI_Allgatherv(mine, m_hi - m_lo, MPI_DOUBLE, all, counts.data(), displs.data(), MPI_DOUBLE,
+                 m_comm);
+}
+
 void Decomposition::broadcast(void* x, int bytes, int root) const {
   if (m_ranks == 1) return;
   MPI_Bcast(x, bytes, MPI_BYTE, root, m_comm);

@@ -44,6 +44,9 @@ class Decomposition {
   // The rank holding the largest value (NaN counts as larger than every number; ties: the
   // lowest rank). Collective.
   int argmax(double x) const;
+  // One value per cell row: this rank's rows [lo, hi) in, every row's out (in row order), on
+  // every rank. Collective.
+  void gather_all_rows(const double* mine, double* all) const;
   // The bytes of `x` from rank `root` to every rank. Collective.
   void broadcast(void* x, int bytes, int root) const;
   // Each rank's rows [lo, hi) of `n_per_row` values (row-major; the last rank's with

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "error.hpp"
+#include "protocol.hpp"
 
 namespace fluid {
 namespace {
@@ -69,7 +70,7 @@ RowSplit split_rows(int rows, int ranks, int rank) {
   s.rows = rows;
   s.ranks = ranks;
   s.rank = rank;
-  s.block = ceil_div(rows, ranks);
+  s.block = fsi::proto::fluid_row_block(rows, ranks);
   // Blocks of ceil(rows / P): the last rank holds what is left, and must hold a row.
   if (s.block * (ranks - 1) >= rows) {
     auto fits = [&](int p) { return ceil_div(rows, p) * (p - 1) < rows; };

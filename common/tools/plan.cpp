@@ -1,7 +1,8 @@
 // fsi-plan SCENE.toml: what the launcher needs to compose the mpirun line, read with the same
 // strict rules as the programs. Prints "roles: fluid solid coupler", "programs: fluid solid-rigid
 // coupler" (the program that plays each role, in the same order: `[solid] program`, by default the
-// role's own) and "name: <scene name>".
+// role's own), "name: <scene name>", "steps: N" and "fluid_ranks: P" (`[fluid] ranks`, default 1:
+// the ranks the launcher gives the fluid).
 // Bad input: "ERROR: ..." on stderr and exit code 1.
 #include <cstdio>
 #include <string>
@@ -25,6 +26,11 @@ int main(int argc, char** argv) {
       const auto t = root.table("solid");
       if (t.has("program")) solid = t.choice("program", {"solid", "solid-rigid"});
     }
+    long fluid_ranks = 1;
+    if (roles.need[static_cast<int>(fsi::Role::fluid)]) {
+      const auto t = root.table("fluid");
+      if (t.has("ranks")) fluid_ranks = t.positive_integer("ranks");
+    }
     for (const char* k : {"fluid", "solid", "fiber", "coupler"}) root.skip(k);
     root.finish();
     std::printf("roles:");
@@ -36,7 +42,8 @@ int main(int argc, char** argv) {
         std::printf(" %s", r == static_cast<int>(fsi::Role::solid)
                                ? solid.c_str()
                                : fsi::role_name(static_cast<fsi::Role>(r)));
-    std::printf("\nname: %s\nsteps: %ld\n", common.name.c_str(), common.steps);
+    std::printf("\nname: %s\nsteps: %ld\nfluid_ranks: %ld\n", common.name.c_str(), common.steps,
+                fluid_ranks);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ERROR: %s\n", e.what());
     return 1;

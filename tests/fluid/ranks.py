@@ -1,16 +1,21 @@
 #!/usr/bin/python3
-"""Run fluid-only scenes on 1 rank and on P ranks and check that the outputs agree to round-off.
+"""Run scenes with the fluid on 1 rank and on P ranks and check that the outputs agree to
+round-off.
 
-  ranks.py --bin BIN --work DIR --ranks P [--tolerance 1e-12] -- MPIEXEC... SCENE.toml...
+  ranks.py --bin BIN --work DIR --ranks P [--programs fluid,solid,coupler] [--t-end T]
+           [--tolerance 1e-12] -- MPIEXEC... SCENE.toml...
 
-Every scene runs as `MPIEXEC -n 1 BIN/fluid SCENE` and `MPIEXEC -n P BIN/fluid SCENE`. Compared:
-every numeric dataset of fluid.h5 and every column of the CSV files, each as the largest
-difference relative to the dataset's largest magnitude; the run fails when one exceeds the
-tolerance, or when a run fails. Prints the largest relative difference per dataset kind.
+Every scene runs as `MPIEXEC -n 1 BIN/fluid SCENE [: -n 1 BIN/solid SCENE ...]` and with `-n P`
+for the fluid (with --t-end, a copy of the scene with that t_end, written beside it so that its
+relative mesh paths hold, and removed after). Compared: every floating-point dataset of every .h5 file and every column of every
+CSV file of the output folder, each as its largest difference relative to its largest
+magnitude; the run fails when one exceeds the tolerance, or when a run fails. Prints the largest
+relative difference per dataset name.
 """
 import argparse
 import glob
 import os
+import re
 import subprocess
 import sys
 
@@ -18,9 +23,14 @@ import h5py
 import numpy as np
 
 
-def run(mpiexec, fluid, ranks, scene, out):
-    cmd = list(mpiexec) + ["-n", str(ranks), fluid, scene, "--out-dir", out, "--overwrite"]
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+def run(mpiexec, bin_dir, programs, ranks, scene, out):
+    cmd = list(mpiexec)
+    for k, p in enumerate(programs):
+        if k:
+            cmd.append(":")
+        n = ranks if p == "fluid" else 1
+        cmd += ["-n", str(n), os.path.join(bin_dir, p), scene, "--out-dir", out, "--overwrite"]
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
     if r.returncode != 0:
         sys.exit(f"ranks: {scene} on {ranks} rank(s) failed (exit {r.returncode}):\n{r.stderr[-2000:]}")
 
@@ -46,6 +56,8 @@ def main():
     ap.add_argument("--bin", required=True)
     ap.add_argument("--work", required=True)
     ap.add_argument("--ranks", type=int, required=True)
+    ap.add_argument("--programs", default="fluid")
+    ap.add_argument("--t-end", type=float)
     ap.add_argument("--tolerance", type=float, default=1e-12)
     ap.add_argument("rest", nargs=argparse.REMAINDER)
     a = ap.parse_args()
@@ -54,21 +66,36 @@ def main():
     mpiexec = [x for x in rest if not x.endswith(".toml")]
     if not scenes or not mpiexec:
         sys.exit("ranks: give the mpiexec command and at least one scene after --")
-    fluid = os.path.join(a.bin, "fluid")
+    programs = a.programs.split(",")
     worst_all, failures = 0.0, []
     for scene in scenes:
         name = os.path.splitext(os.path.basename(scene))[0]
         one, many = (os.path.join(a.work, f"{name}-{p}") for p in (1, a.ranks))
-        run(mpiexec, fluid, 1, scene, one)
-        run(mpiexec, fluid, a.ranks, scene, many)
-        d1, dp = datasets(os.path.join(one, "fluid.h5")), datasets(os.path.join(many, "fluid.h5"))
-        if sorted(d1) != sorted(dp):
-            failures.append(f"{name}: the runs wrote different datasets")
-            continue
+        copy = None
+        if a.t_end is not None:
+            text, n = re.subn(r"(?m)^t_end\s*=.*$", f"t_end = {a.t_end!r}", open(scene).read(), count=1)
+            if n != 1:
+                sys.exit(f"ranks: no t_end line in {scene}")
+            copy = os.path.splitext(scene)[0] + f"_ranks_{os.getpid()}.toml"
+            with open(copy, "w") as f:
+                f.write(text)
+        try:
+            run(mpiexec, a.bin, programs, 1, copy or scene, one)
+            run(mpiexec, a.bin, programs, a.ranks, copy or scene, many)
+        finally:
+            if copy:
+                os.remove(copy)
         kinds = {}
-        for key in d1:
-            kind = key.split("/")[-1]
-            kinds[kind] = max(kinds.get(kind, 0.0), relative(d1[key], dp[key]))
+        for h5 in sorted(glob.glob(os.path.join(one, "*.h5"))):
+            other = os.path.join(many, os.path.basename(h5))
+            d1 = datasets(h5)
+            dp = datasets(other) if os.path.exists(other) else {}
+            if sorted(d1) != sorted(dp):
+                failures.append(f"{name}: the runs wrote different datasets in {os.path.basename(h5)}")
+                continue
+            for key in d1:
+                kind = os.path.basename(h5)[:-3] + ":" + key.split("/")[-1]
+                kinds[kind] = max(kinds.get(kind, 0.0), relative(d1[key], dp[key]))
         for csv in sorted(glob.glob(os.path.join(one, "*.csv"))):
             x = np.loadtxt(csv, delimiter=",", skiprows=1, ndmin=2)
             y = np.loadtxt(os.path.join(many, os.path.basename(csv)), delimiter=",", skiprows=1, ndmin=2)
@@ -76,7 +103,7 @@ def main():
         if not kinds:
             failures.append(f"{name}: nothing compared")
         for kind, d in sorted(kinds.items()):
-            print(f"{name}: {kind:24s} largest relative difference {d:.3g}")
+            print(f"{name}: {kind:32s} largest relative difference {d:.3g}")
             worst_all = max(worst_all, d)
             if not d <= a.tolerance:
                 failures.append(f"{name}: {kind} differs by {d:.3g} (tolerance {a.tolerance:g})")
