@@ -34,7 +34,7 @@ usage: ./fsi COMMAND [ARGS]
                               (build-sanitize/); unit and integration tests
   validate [CASE...]          run the validation cases in runs/ (all when none is named)
   bench [WHAT]                run a benchmark (fluid, solid, fiber, coupler, coupled, protocol,
-                              vocal-folds);
+                              vocal-folds, fluid-ranks);
                               without WHAT, list them
   build                       install missing packages, configure and build (incremental)
   deps                        install missing Debian packages (as root) or list them
@@ -292,7 +292,7 @@ validate() {
 bench() {
   build
   local what=${1:-}
-  local available=(protocol coupled vocal-folds)
+  local available=(protocol coupled vocal-folds fluid-ranks)
   for b in "$BIN"/bench_*; do [ -x "$b" ] && available+=("${b##*/bench_}"); done
   if [ -z "$what" ]; then
     say "benchmarks: ${available[*]}"
@@ -305,6 +305,9 @@ bench() {
     bench_coupled
   elif [ "$what" = vocal-folds ]; then
     bench_vocal_folds
+  elif [ "$what" = fluid-ranks ]; then
+    /usr/bin/python3 "$ROOT/runs/bench-fluid-ranks/bench.py" --bin "$BIN" \
+      --out "$ROOT/out/bench/fluid-ranks.json" --work "$ROOT/out/bench/fluid-ranks"
   elif [ -x "$BIN/bench_$what" ]; then
     "$BIN/bench_$what" --out "$ROOT/out/bench/$what.json"
   else

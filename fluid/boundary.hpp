@@ -40,7 +40,9 @@ class Boundaries {
  public:
   // d: the rows this process holds (its loops run over them; sums over the sides are taken
   // over all ranks, in the same order of collectives on every rank).
-  Boundaries(const Grid& g, const std::array<SideBc, 4>& bc, const Decomposition& d = {});
+  // d must outlive the Boundaries (the solver's own).
+  Boundaries(const Grid& g, const std::array<SideBc, 4>& bc,
+             const Decomposition& d = whole_grid());
   const SideBc& side(int s) const { return m_bc[s]; }
   const GhostRule& rule(int s) const { return m_rule[s]; }
   bool has_outflow() const { return m_has_outflow; }
@@ -71,13 +73,14 @@ class Boundaries {
   int row_lo() const { return m_d.lo(); }
   int row_hi() const { return m_d.hi(); }
   bool holds(int s) const { return s < 2 || (s == bottom ? m_d.has_bottom() : m_d.has_top()); }
+
   // Per-position values along side s, given for this rank's positions in m_mine (its rows, or
   // every column when it holds a bottom or top side), as the whole side's on every rank: sums
   // over a side then run in the one-rank order, and give its bits on any number of ranks.
   const std::vector<double>& whole_side(int s) const;
 
   const Grid& m_g;
-  Decomposition m_d;
+  const Decomposition& m_d;
   std::array<SideBc, 4> m_bc;
   std::array<GhostRule, 4> m_rule;
   bool m_has_outflow = false;

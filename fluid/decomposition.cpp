@@ -28,6 +28,11 @@ Decomposition::Decomposition(MPI_Comm comm, int ny, bool periodic_y)
         ny, m_ranks, last, s.block));
 }
 
+const Decomposition& whole_grid() {
+  static const Decomposition d;
+  return d;
+}
+
 int Decomposition::owner(int j) const {
   if (m_ranks == 1) return 0;
   return std::clamp(std::clamp(j, 0, m_ny - 1) / m_block, 0, m_ranks - 1);
@@ -39,23 +44,36 @@ void Decomposition::halo(Field& f) const {
   const int down = first ? (m_periodic ? m_ranks - 1 : MPI_PROC_NULL) : m_rank - 1;
   const int up = last ? (m_periodic ? 0 : MPI_PROC_NULL) : m_rank + 1;
   const int n = f.sx;
+  const double t0 = MPI_Wtime();
   // Row lo down (the lower neighbour's row hi), row hi up from it; row hi - 1 up, row lo - 1 in.
   MPI_Sendrecv(f.row(m_lo) - 1, n, MPI_DOUBLE, down, 7301, f.row(m_hi) - 1, n, MPI_DOUBLE, up,
                7301, m_comm, MPI_STATUS_IGNORE);
   MPI_Sendrecv(f.row(m_hi - 1) - 1, n, MPI_DOUBLE, up, 7302, f.row(m_lo - 1) - 1, n, MPI_DOUBLE,
                down, 7302, m_comm, MPI_STATUS_IGNORE);
+  m_traffic.halo_seconds += MPI_Wtime() - t0;
+  ++m_traffic.halos;
+  m_traffic.halo_bytes += 8.0 * n * ((down != MPI_PROC_NULL) + (up != MPI_PROC_NULL));
+}
+
+// Times a collective into the traffic counters.
+template <class F>
+void Decomposition::collective(F&& f) const {
+  const double t0 = MPI_Wtime();
+  f();
+  m_traffic.collective_seconds += MPI_Wtime() - t0;
+  ++m_traffic.collectives;
 }
 
 double Decomposition::sum(double x) const {
   if (m_ranks == 1) return x;
   double s = 0;
-  MPI_Allreduce(&x, &s, 1, MPI_DOUBLE, MPI_SUM, m_comm);
+  collective([&] { MPI_Allreduce(&x, &s, 1, MPI_DOUBLE, MPI_SUM, m_comm); });
   return s;
 }
 
 void Decomposition::sum(double* x, int n) const {
   if (m_ranks == 1) return;
-  MPI_Allreduce(MPI_IN_PLACE, x, n, MPI_DOUBLE, MPI_SUM, m_comm);
+  collective([&] { MPI_Allreduce(MPI_IN_PLACE, x, n, MPI_DOUBLE, MPI_SUM, m_comm); });
 }
 
 int Decomposition::argmax(double x) const {
@@ -64,7 +82,7 @@ int Decomposition::argmax(double x) const {
     double value;
     int rank;
   } in{std::isnan(x) ? std::numeric_limits<double>::infinity() : x, m_rank}, out{};
-  MPI_Allreduce(&in, &out, 1, MPI_DOUBLE_INT, MPI_MAXLOC, m_comm);
+  collective([&] { MPI_Allreduce(&in, &out, 1, MPI_DOUBLE_INT, MPI_MAXLOC, m_comm); });
   return out.rank;
 }
 
@@ -78,13 +96,15 @@ void Decomposition::gather_all_rows(const double* mine, double* all) const {
     displs[r] = std::min(m_ny, r * m_block);
     counts[r] = std::min(m_ny, (r + 1) * m_block) - displs[r];
   }
-  MPI_Allgatherv(mine, m_hi - m_lo, MPI_DOUBLE, all, counts.data(), displs.data(), MPI_DOUBLE,
-                 m_comm);
+  collective([&] {
+    MPI_Allgatherv(mine, m_hi - m_lo, MPI_DOUBLE, all, counts.data(), displs.data(), MPI_DOUBLE,
+                   m_comm);
+  });
 }
 
 void Decomposition::broadcast(void* x, int bytes, int root) const {
   if (m_ranks == 1) return;
-  MPI_Bcast(x, bytes, MPI_BYTE, root, m_comm);
+  collective([&] { MPI_Bcast(x, bytes, MPI_BYTE, root, m_comm); });
 }
 
 void Decomposition::gather_rows(const double* local, int n_per_row, int local_rows, double* all,

@@ -49,6 +49,14 @@ class Decomposition {
   void gather_all_rows(const double* mine, double* all) const;
   // The bytes of `x` from rank `root` to every rank. Collective.
   void broadcast(void* x, int bytes, int root) const;
+  // What the exchanges cost this rank so far (the scaling model's input): wall seconds, calls
+  // and bytes sent, for the halos (two messages each) and for the reductions and gathers.
+  struct Traffic {
+    double halo_seconds = 0, collective_seconds = 0;
+    long halos = 0, collectives = 0;
+    double halo_bytes = 0;
+  };
+  const Traffic& traffic() const { return m_traffic; }
   // Each rank's rows [lo, hi) of `n_per_row` values (row-major; the last rank's with
   // `extra_last_rows` more, e.g. the top v faces) gathered on rank 0 into `all`, in row order.
   // Collective.
@@ -56,9 +64,16 @@ class Decomposition {
                    int extra_last_rows = 0) const;
 
  private:
+  template <class F>
+  void collective(F&& f) const;
+
   MPI_Comm m_comm = MPI_COMM_NULL;
   int m_rank = 0, m_ranks = 1, m_ny = 0, m_lo = 0, m_hi = 0, m_block = 0;
   bool m_periodic = false;
+  mutable Traffic m_traffic;
 };
+
+// The one-rank decomposition, for who holds a reference to one without a split.
+const Decomposition& whole_grid();
 
 }  // namespace fluid

@@ -302,6 +302,21 @@ nlohmann::json FluidProgram::report() const {
                  {"poisson", tm.poisson},
                  {"projection", tm.projection}};
   j["ns_per_cell_step"] = 1e9 * total / (cells * steps);
+  // On several ranks: this rank's rows and what its exchanges cost (inside the phases above).
+  const Decomposition& d = m_solver->decomposition();
+  if (!d.serial()) {
+    const auto& tr = d.traffic();
+    const auto tt = m_solver->transpose_traffic();
+    j["rows"] = {d.lo(), d.hi()};
+    j["communication"] = {{"halo_seconds", tr.halo_seconds},
+                          {"halos", tr.halos},
+                          {"halo_bytes", tr.halo_bytes},
+                          {"collective_seconds", tr.collective_seconds},
+                          {"collectives", tr.collectives},
+                          {"transpose_seconds", tt.seconds},
+                          {"transposes", tt.count},
+                          {"transpose_bytes", tt.bytes}};
+  }
   j["max_divergence"] = max_divergence(*m_solver).value;
   j["kinetic_energy"] = kinetic_energy(*m_solver);
   if (m_flow) j["flow_rate"] = flow_rate_report();

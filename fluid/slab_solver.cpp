@@ -44,10 +44,15 @@ fftw_plan lines_plan(int n, int count, double* p, int stride, int dist, fftw_r2r
   return plan;
 }
 
+// FFTW_MEASURE: a transpose only moves values, so whichever algorithm the timings pick, the
+// results keep their bits (the transforms stay FFTW_ESTIMATE, whose round-off is the same from
+// run to run); measured, it halves the transposes' time against FFTW_ESTIMATE
+// (runs/bench-fluid-ranks). Planning overwrites the buffer: the solver's input is written whole
+// before each solve.
 fftw_plan transpose_plan(int n0, int n1, int b0, int b1, double* p, MPI_Comm comm,
                          unsigned flags) {
   fftw_plan plan = fftw_mpi_plan_many_transpose(n0, n1, 1, b0, b1, p, p, comm,
-                                                FFTW_ESTIMATE | flags);
+                                                FFTW_MEASURE | flags);
   if (!plan) fsi::fail("fluid::SlabSolver: FFTW could not plan a {} x {} transpose", n0, n1);
   return plan;
 }
@@ -128,6 +133,8 @@ SlabSolver::SlabSolver(const Operator1D& t, const Operator1D& s, double sigma, i
       {std::size_t(alloc), std::size_t(nloc) * m_nx, std::size_t(c1 - c0) * rows, 1});
   m_buf = fftw_alloc_real(size);
   std::fill(m_buf, m_buf + size, 0.0);
+  // A transpose sends this rank's values but its own block: about (P - 1) / P of its share.
+  m_bytes_per_transpose = 8.0 * double(rows) * ncol / ranks * (ranks - 1) / ranks;
 
   const Kinds kt = kinds_for(m_nt, t.lo, t.hi);
   m_lt = eigenvalues(m_nt, t.h, t.lo, t.hi);
@@ -203,21 +210,29 @@ SlabSolver::~SlabSolver() {
   fftw_free(m_buf);
 }
 
+void SlabSolver::transpose(fftw_plan p) {
+  const double t0 = MPI_Wtime();
+  run(p);
+  m_transpose_seconds += MPI_Wtime() - t0;
+  ++m_transposes;
+  m_transpose_bytes += m_bytes_per_transpose;
+}
+
 void SlabSolver::solve() {
   if (m_t_axis == 0) {
     run(m_t_fwd);
-    run(m_to_lines);
+    transpose(m_to_lines);
     lines();
-    run(m_from_lines);
+    transpose(m_from_lines);
     run(m_t_bwd);
   } else {
-    run(m_to_y);
+    transpose(m_to_y);
     run(m_t_fwd);
-    run(m_to_lines);
+    transpose(m_to_lines);
     lines();
-    run(m_from_lines);
+    transpose(m_from_lines);
     run(m_t_bwd);
-    run(m_from_y);
+    transpose(m_from_y);
   }
 }
 

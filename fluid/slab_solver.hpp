@@ -58,11 +58,16 @@ class SlabSolver {
   // A padded row (global row < pad) is ignored on input and left as it is on output.
   double* data() { return m_buf; }
   void solve();
+  // The transposes so far: their count, wall seconds and the bytes this rank sent to others.
+  long transposes() const { return m_transposes; }
+  double transpose_seconds() const { return m_transpose_seconds; }
+  double transpose_bytes() const { return m_transpose_bytes; }
   // For a singular problem: the solution's weighted mean (weights per s index, whole) is zero.
   void set_mean_weights(const std::vector<double>& w) { m_weights = w; }
 
  private:
   void lines();  // step 3 (t = x) or 4 (t = y): per local wavenumber, along s
+  void transpose(fftw_plan p);
 
   int m_t_axis, m_pad, m_nx, m_nt, m_ns;
   RowSplit m_split;
@@ -82,6 +87,9 @@ class SlabSolver {
   double m_sigma;
   bool m_singular;
   MPI_Comm m_comm;
+  long m_transposes = 0;
+  double m_transpose_seconds = 0, m_transpose_bytes = 0;
+  double m_bytes_per_transpose = 0;
 };
 
 }  // namespace fluid

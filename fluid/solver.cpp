@@ -221,6 +221,17 @@ std::size_t Solver::solve_size(int which) const {
   return std::size_t(f.row_length()) * (f.split().hi - f.split().lo);
 }
 
+Solver::TransposeTraffic Solver::transpose_traffic() const {
+  TransposeTraffic t;
+  for (const auto* s : {m_slab_poisson.get(), m_slab_u.get(), m_slab_v.get()}) {
+    if (!s) continue;
+    t.count += s->transposes();
+    t.seconds += s->transpose_seconds();
+    t.bytes += s->transpose_bytes();
+  }
+  return t;
+}
+
 void Solver::solve(int which) {
   if (m_dec.serial()) return (which == 0 ? *m_helm_u : which == 1 ? *m_helm_v : *m_poisson).solve();
   (which == 0 ? *m_slab_u : which == 1 ? *m_slab_v : *m_slab_poisson).solve();

@@ -121,6 +121,13 @@ class Solver {
   void reset_timings() { m_time = {}; }
   // Acceleration of the body force at time t (force per unit volume / rho + g).
   std::array<double, 2> body_acceleration(double t) const;
+  // On several ranks: the transposes of the Poisson and Helmholtz solves so far (count, wall
+  // seconds, bytes this rank sent).
+  struct TransposeTraffic {
+    long count = 0;
+    double seconds = 0, bytes = 0;
+  };
+  TransposeTraffic transpose_traffic() const;
   // The bare Poisson solver (for the benchmark's floor and tests; on one rank).
   FastSolver& poisson() { return *m_poisson; }
 
