@@ -8,16 +8,23 @@ ranks, run alternately twice (the faster of each pair is kept: the machine is sh
 fluid's own timings (summary.json): the time per step, and on 2 ranks what its exchanges cost
 (halos, reductions, transposes) with their counts and bytes.
 
-The model, per step and rank on P ranks of a grid of N cells, nx columns:
-  T(P) = c N / P                                     compute, c from the 1-rank run
-       + H 2 (a + 8 (nx + 2) / b)                    H halo exchanges, two rows each
-       + X ((P - 1) a + 8 N (P - 1) / P^2 / b)       X transposes, an all-to-all each
-       + C a_c ceil(log2 P)                          C reductions, a tree of log2 P rounds
-with a (latency per message) and b (bandwidth) fitted to the halo and transpose times measured
-on 2 ranks, and a_c the measured time of one reduction. The split holds at most ny / 2 ranks
-(two rows each). A coupled step adds the one-rank solid and the coupler: from the default
-scene's run on one fluid rank, their time per step; the fluid stops being the largest part at
-the P where its T(P) falls below the solid's.
+The model, per step and rank on P ranks of a grid of N cells:
+  T(P) = c N / P                                         compute, c from the 1-rank run
+       + H t_h                                           H halo exchanges, each as measured on 2
+                                                           ranks (a neighbour exchange: the same
+                                                           on any P)
+       + X ((P - 1) a + 8 N (P - 1) / P^2 / b + g 8 N / P)
+                                                         X transposes: an all-to-all of P - 1
+                                                           messages, and FFTW's local reordering
+       + C t_r ceil(log2 P)                              C reductions, a tree of log2 P rounds,
+                                                           t_r per round as measured on 2 ranks
+with a (latency) and b (bandwidth) from a ping-pong between two ranks (pingpong.py, mpi4py),
+g (seconds per byte of local reordering) fitted to the transposes measured on 2 ranks. The
+halos and reductions measured on 2 ranks include the time a rank waits for the other (the
+imbalance of a shared machine); the model keeps it per call. The split holds at most ny / 2
+ranks (two rows each). A coupled step adds the one-rank solid and the coupler: from the default
+scene's run on one fluid rank, their time per step; the solid is the larger part where the
+fluid's T(P) falls below the solid's work.
 
 Usage: bench.py --bin BIN --out OUT.json --work DIR [--quick]
 """
@@ -147,20 +154,30 @@ def main():
                     best[p] = r
         measured[f"{nx}x{ny}"] = {"nx": nx, "ny": ny, "cells": nx * ny, "1": best[1], "2": best[2],
                                   "speedup": best[1]["ms_per_step"] / best[2]["ms_per_step"]}
-    # Fit the message costs on 2 ranks: per halo two messages of a row; per transpose one message
-    # of (P - 1) / P of the rank's share.
-    pts, coll = [], []
+    # Message latency and bandwidth from a ping-pong between two ranks.
+    pp_json = os.path.join(a.work, "pingpong.json")
+    r = subprocess.run(mpirun() + ["-n", "2", sys.executable,
+                                   os.path.join(os.path.dirname(os.path.abspath(__file__)), "pingpong.py"),
+                                   pp_json], capture_output=True, text=True, timeout=300)
+    if r.returncode != 0:
+        sys.exit(f"bench-fluid-ranks: the ping-pong failed:\n{r.stderr[-2000:]}")
+    pp = {int(k): v for k, v in json.load(open(pp_json)).items()}
+    alpha = pp[min(pp)]
+    big = max(pp)
+    beta = big / (pp[big] - alpha)
+    # Per call on 2 ranks: halos and reductions as measured; the transposes' local reordering g
+    # is what their measured time leaves beyond the messages.
+    th, tr, gs = [], [], []
     for g in measured.values():
         c = g["2"]["per_step"]
-        if c["halos"] > 0:
-            pts.append((8.0 * (g["nx"] + 2), c["halo_seconds"] / c["halos"] / 2))
+        th.append(c["halo_seconds"] / c["halos"])
+        tr.append(c["collective_seconds"] / c["collectives"])
         if c["transposes"] > 0:
-            pts.append((c["transpose_bytes"] / c["transposes"], c["transpose_seconds"] / c["transposes"]))
-        if c["collectives"] > 0:
-            coll.append(c["collective_seconds"] / c["collectives"])
-    alpha, beta = fit(pts)
-    alpha_c = sum(coll) / len(coll)
+            t = c["transpose_seconds"] / c["transposes"]
+            sent = c["transpose_bytes"] / c["transposes"]  # 8 N / 4 on 2 ranks
+            gs.append(max(0.0, t - alpha - sent / beta) / (2 * sent))
     ref = measured[list(measured)[-1]]
+    t_halo, t_red, gamma = th[-1], tr[-1], sum(gs) / len(gs)
     c_cell = ref["1"]["ms_per_step"] * 1e-3 / ref["cells"]
     per = ref["2"]["per_step"]
     H, X, C = per["halos"], per["transposes"], per["collectives"]
@@ -169,9 +186,9 @@ def main():
         N = nx * ny
         t = c_cell * N / P
         if P > 1:
-            t += H * 2 * (alpha + 8 * (nx + 2) / beta)
-            t += X * ((P - 1) * alpha + 8 * N * (P - 1) / P ** 2 / beta)
-            t += C * alpha_c * math.ceil(math.log2(P))
+            t += H * t_halo
+            t += X * ((P - 1) * alpha + 8 * N * (P - 1) / P ** 2 / beta + gamma * 8 * N / P)
+            t += C * t_red * math.ceil(math.log2(P))
         return 1e3 * t
 
     default = None if a.quick else run_default(a.bin, a.work, 400)
@@ -197,8 +214,10 @@ def main():
 
     result = {"measured": measured,
               "fit": {"latency_us": 1e6 * alpha, "bandwidth_GB_s": beta / 1e9,
-                      "reduction_us": 1e6 * alpha_c, "ns_per_cell_step": 1e9 * c_cell,
-                      "per_step": {"halos": H, "transposes": X, "reductions": C}},
+                      "halo_us": 1e6 * t_halo, "reduction_round_us": 1e6 * t_red,
+                      "reordering_ns_per_byte": 1e9 * gamma, "ns_per_cell_step": 1e9 * c_cell,
+                      "per_step": {"halos": H, "transposes": X, "reductions": C},
+                      "pingpong_seconds": pp},
              "default_scene": default, "model": pred}
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
     json.dump(result, open(a.out, "w"), indent=2)
@@ -213,8 +232,10 @@ def main():
               f" transposes {1e3 * c['transpose_seconds']:.3f} ms ({c['transposes']:.0f},"
               f" {c['transpose_bytes'] / 1e6:.2f} MB)")
     f = result["fit"]
-    print(f"fit: latency {f['latency_us']:.2f} us, bandwidth {f['bandwidth_GB_s']:.2f} GB/s, reduction"
-          f" {f['reduction_us']:.2f} us per round, compute {f['ns_per_cell_step']:.2f} ns per cell-step")
+    print(f"ping-pong: latency {f['latency_us']:.2f} us, bandwidth {f['bandwidth_GB_s']:.2f} GB/s; on 2 ranks"
+          f" per call: halo {f['halo_us']:.1f} us, reduction {f['reduction_round_us']:.1f} us, transposes'"
+          f" reordering {f['reordering_ns_per_byte']:.3f} ns/B; compute {f['ns_per_cell_step']:.2f} ns"
+          f" per cell-step")
     if default:
         print(f"default scene (FSI2, 500 x 82, one fluid rank): {default['ms_per_step']:.3f} ms per step;"
               f" fluid work {default['fluid_work_ms']:.3f}, solid work {default['solid_work_ms']:.3f},"
