@@ -84,7 +84,12 @@ std::filesystem::path checkpoint_file(const std::filesystem::path& out_dir, long
   return checkpoint_folder(out_dir, step) / fmt::format("{}.h5", role_name(role));
 }
 
-void write_checkpoint(const Runtime& rt, long step, const std::function<void(H5File&)>& fill) {
+void write_checkpoint(const Runtime& rt, long step, const std::function<void(H5File&)>& fill,
+                      const std::function<void()>& others) {
+  if (!rt.is_root()) {
+    if (others) others();
+    return;
+  }
   const auto folder = checkpoint_folder(rt.out_dir(), step);
   std::filesystem::create_directories(folder);
   const auto path = checkpoint_file(rt.out_dir(), step, rt.role());

@@ -23,8 +23,11 @@ std::filesystem::path checkpoint_file(const std::filesystem::path& out_dir, long
 // `fill` writes the state into the file; the file also records the step, the time and the
 // program's effective scene (checked at a restart). Then the folders of steps older than the
 // program's previous checkpoint are cleared of this program's file (and removed when empty), so
-// that the newest complete checkpoint is never lost.
-void write_checkpoint(const Runtime& rt, long step, const std::function<void(H5File&)>& fill);
+// that the newest complete checkpoint is never lost. A program on several ranks (the fluid):
+// its rank 0 writes the file, calling `fill`; the other ranks call `others` instead, which takes
+// part in the same collective gathers without a file.
+void write_checkpoint(const Runtime& rt, long step, const std::function<void(H5File&)>& fill,
+                      const std::function<void()>& others = {});
 
 // The newest step of out_dir/checkpoint whose folder holds a file of every role in `roles`.
 std::optional<long> newest_checkpoint(const std::filesystem::path& out_dir, const RoleSet& roles);

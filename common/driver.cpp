@@ -87,7 +87,7 @@ void run_alone(Runtime& rt, Port& port, Advance advance) {
     progress.update(n, step_time(s, n), s.dt, [&] { return port.status(); });
     const bool stop = rt.stop_requested();
     if (stop || is_checkpoint_step(s, n))
-      write_checkpoint(rt, n, [&](H5File& h5) { port.save(h5); });
+      write_checkpoint(rt, n, [&](H5File& h5) { port.save(h5); }, [&] { port.save_ranks(); });
     if (stop) break;
   }
   nlohmann::json j = base_summary(rt, n);
@@ -119,7 +119,8 @@ void follow(Runtime& rt, Port& port, Advance advance) {
   // The committed step `steps` (state at t_done): its output, and its checkpoint when asked.
   auto commit_step = [&](bool checkpoint) {
     port.output(steps, t_done, is_output_step(s, steps));
-    if (checkpoint) write_checkpoint(rt, steps, [&](H5File& h5) { port.save(h5); });
+    if (checkpoint)
+      write_checkpoint(rt, steps, [&](H5File& h5) { port.save(h5); }, [&] { port.save_ranks(); });
     pending = false;
   };
   for (;;) {

@@ -37,7 +37,10 @@ class SolverPort {
   // load(): in a restarted run, before anything is sent or written, the same back; the port has
   // already reopened its output files to continue them (their rows up to the restart time kept).
   // A run stopped and restarted gives the same results bit for bit. The default refuses.
+  // A program on several ranks: rank 0 calls save(), the others save_ranks() at the same
+  // point (collective gathers without a file; the default does nothing); load() on every rank.
   virtual void save(H5File& h5) const;
+  virtual void save_ranks() const {}
   virtual void load(const H5File& h5);
 };
 

@@ -63,8 +63,9 @@ class Boundaries {
   // Net volume flux into the domain through its boundary (per unit depth).
   double net_inflow(const Field& u, const Field& v) const;
   // What advance_normal() carries from step to step (the outflows' last interior lines, the
-  // walls' speeds), for checkpoints: saved into and loaded from group `group`.
-  void save(fsi::H5File& h5, const std::string& group) const;
+  // walls' speeds), for checkpoints: saved into and loaded from group `group`, the whole
+  // boundary's (on several ranks save() gathers on rank 0, which passes the file; collective).
+  void save(fsi::H5File* h5, const std::string& group) const;
   void load(const fsi::H5File& h5, const std::string& group);
 
  private:

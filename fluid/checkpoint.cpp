@@ -7,12 +7,19 @@ namespace fluid {
 
 namespace {
 
+// The whole grid's values of f (ghosts included, the one-rank layout) into the rows it stores.
 void load_field(const fsi::H5File& h5, const std::string& name, Field& f) {
   std::vector<double> a = h5.read_doubles(name);
-  if (a.size() != f.a.size())
+  const std::size_t whole = std::size_t(f.sx) * (f.nj + 2);
+  if (a.size() != whole)
     fsi::fail("checkpoint {}: {} has {} values, the grid {} (another grid?)", h5.path().string(), name,
-              a.size(), f.a.size());
-  f.a = std::move(a);
+              a.size(), whole);
+  if (f.a.size() == whole) {
+    f.a = std::move(a);
+    return;
+  }
+  std::copy(a.begin() + std::size_t(f.jlo) * f.sx, a.begin() + std::size_t(f.jlo) * f.sx + f.a.size(),
+            f.a.begin());
 }
 
 }  // namespace
@@ -20,18 +27,25 @@ void load_field(const fsi::H5File& h5, const std::string& name, Field& f) {
 // The fields with their ghosts; H^n, which the next step's AB2 predictor weighs against H^(n+1)
 // (after a step it is in m_hu_old, m_hv_old); dt of the last step (AB2's dt') and the clock as
 // the steps accumulated it (not n dt, so that the sums stay bit for bit).
-void Solver::save(fsi::H5File& h5) const {
+void Solver::save(fsi::H5File* h5) const {
   if (m_phase == Phase::begun) fsi::fail("fluid::Solver::save: a step is under way");
-  h5.write("fluid/u", m_u.a);
-  h5.write("fluid/v", m_v.a);
-  h5.write("fluid/p", m_p.a);
-  h5.write("fluid/hu", m_hu_old.a);
-  h5.write("fluid/hv", m_hv_old.a);
-  h5.write("fluid/hu_spare", m_hu.a);  // overwritten by the next step; kept for exactness
-  h5.write("fluid/hv_spare", m_hv.a);
-  h5.write("fluid/clock", std::vector<double>{m_t, m_dt_prev});
-  h5.write("fluid/step", std::vector<std::int64_t>{m_step});
+  const std::pair<const char*, const Field*> fields[] = {
+      {"fluid/u", &m_u},       {"fluid/v", &m_v},        {"fluid/p", &m_p},
+      {"fluid/hu", &m_hu_old}, {"fluid/hv", &m_hv_old},
+      // overwritten by the next step; kept for exactness
+      {"fluid/hu_spare", &m_hu}, {"fluid/hv_spare", &m_hv}};
+  for (const auto& [name, f] : fields) {
+    if (m_dec.serial()) {
+      h5->write(name, f->a);
+      continue;
+    }
+    const std::vector<double> all = m_dec.gather_field(*f);
+    if (h5) h5->write(name, all);
+  }
   m_bnd.save(h5, "fluid/boundaries");
+  if (!h5) return;
+  h5->write("fluid/clock", std::vector<double>{m_t, m_dt_prev});
+  h5->write("fluid/step", std::vector<std::int64_t>{m_step});
 }
 
 void Solver::load(const fsi::H5File& h5) {
@@ -49,9 +63,22 @@ void Solver::load(const fsi::H5File& h5) {
   m_phase = Phase::between_steps;
 }
 
-void Boundaries::save(fsi::H5File& h5, const std::string& group) const {
-  fsi::write_vectors(h5, group + "/previous", {m_prev.begin(), m_prev.end()});
-  h5.write(group + "/speed", std::vector<double>(m_speed.begin(), m_speed.end()));
+// An outflow's last interior line per side: along a left or right side the rows' values of
+// every rank, along a bottom or top side that of the rank holding it; the whole side's in the
+// file.
+void Boundaries::save(fsi::H5File* h5, const std::string& group) const {
+  std::vector<std::vector<double>> prev(m_prev.begin(), m_prev.end());
+  // A checkpoint follows a step, which set the line of every outflow side: on several ranks the
+  // whole side's line from the ranks' parts (collective, the same sides on every rank).
+  if (!m_d.serial())
+    for (int s = 0; s < 4; ++s) {
+      if (m_bc[s].type != BcType::outflow) continue;
+      m_mine = m_prev[s];
+      prev[s] = whole_side(s);
+    }
+  if (!h5) return;
+  fsi::write_vectors(*h5, group + "/previous", prev);
+  h5->write(group + "/speed", std::vector<double>(m_speed.begin(), m_speed.end()));
 }
 
 void Boundaries::load(const fsi::H5File& h5, const std::string& group) {
@@ -59,7 +86,18 @@ void Boundaries::load(const fsi::H5File& h5, const std::string& group) {
   const auto speed = h5.read_doubles(group + "/speed");
   if (prev.size() != m_prev.size() || speed.size() != m_speed.size())
     fsi::fail("checkpoint {}: {} is not of four sides", h5.path().string(), group);
-  for (std::size_t s = 0; s < m_prev.size(); ++s) m_prev[s] = prev[s], m_speed[s] = speed[s];
+  for (std::size_t s = 0; s < m_prev.size(); ++s) {
+    m_speed[s] = speed[s];
+    if (m_d.serial() || prev[s].empty()) {
+      m_prev[s] = prev[s];
+      continue;
+    }
+    // This rank's part of the whole side's line.
+    if (s < 2)
+      m_prev[s].assign(prev[s].begin() + row_lo(), prev[s].begin() + row_hi());
+    else
+      m_prev[s] = holds(int(s)) ? prev[s] : std::vector<double>{};
+  }
 }
 
 }  // namespace fluid

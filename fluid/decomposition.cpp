@@ -102,6 +102,32 @@ void Decomposition::gather_all_rows(const double* mine, double* all) const {
   });
 }
 
+std::vector<double> Decomposition::gather_field(const Field& f) const {
+  if (m_ranks == 1) return f.a;
+  // Rank r sends its rows [lo, top) (top: f's stored end, hi or the v faces' ny + 1), rank 0
+  // also the ghost row below, the last rank the ghost row above: the whole grid's rows -1 ..
+  // nj once each.
+  auto first = [&](int r) { return lo_of(r) - (r == 0 ? 1 : 0); };
+  auto end = [&](int r) {
+    const int top = r == m_ranks - 1 ? f.nj : hi_of(r);
+    return top + (r == m_ranks - 1 ? 1 : 0);
+  };
+  std::vector<int> counts(m_ranks), displs(m_ranks);
+  for (int r = 0; r < m_ranks; ++r) {
+    counts[r] = (end(r) - first(r)) * f.sx;
+    displs[r] = (first(r) + 1) * f.sx;
+  }
+  if (end(m_rank) > f.jhi + 1 || first(m_rank) < f.jlo - 1)
+    fsi::fail("fluid::Decomposition::gather_field: a field of rows [{}, {}) on rank {}", f.jlo,
+              f.jhi, m_rank);
+  std::vector<double> all(m_rank == 0 ? std::size_t(f.sx) * (f.nj + 2) : 0);
+  collective([&] {
+    MPI_Gatherv(f.row(first(m_rank)) - 1, counts[m_rank], MPI_DOUBLE, all.data(), counts.data(),
+                displs.data(), MPI_DOUBLE, 0, m_comm);
+  });
+  return all;
+}
+
 void Decomposition::broadcast(void* x, int bytes, int root) const {
   if (m_ranks == 1) return;
   collective([&] { MPI_Bcast(x, bytes, MPI_BYTE, root, m_comm); });

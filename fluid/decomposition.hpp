@@ -7,7 +7,9 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <array>
+#include <vector>
 
 #include "field.hpp"
 
@@ -28,6 +30,13 @@ class Decomposition {
   int hi() const { return m_hi; }
   // The rank whose cell rows hold row j (j clamped to the grid's rows).
   int owner(int j) const;
+  // Rank r's cell rows [lo_of(r), hi_of(r)).
+  int lo_of(int r) const { return m_ranks == 1 ? 0 : std::min(m_ny, r * m_block); }
+  int hi_of(int r) const { return m_ranks == 1 ? m_ny : std::min(m_ny, (r + 1) * m_block); }
+  // The stored rows of f (its ghost rows included, of the whole grid's first and last rank only)
+  // gathered on rank 0 in the one-rank layout of a Field of f's extents; empty elsewhere.
+  // Collective.
+  std::vector<double> gather_field(const Field& f) const;
   bool has_bottom() const { return m_rank == 0; }
   bool has_top() const { return m_rank == m_ranks - 1; }
   // Rows a field stores besides its ghosts: cell-row fields [lo, hi); the v faces [lo, v_hi()).

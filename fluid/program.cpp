@@ -16,11 +16,6 @@ FluidProgram::FluidProgram(fsi::Runtime& rt)
     : m_rt(rt),
       m_cfg(read_config(rt.root().table("fluid"), rt.settings().dt)),
       m_solver(std::make_unique<Solver>(m_cfg, rt.settings().dt, rt.program_comm())) {
-  if (rt.program_size() > 1 && (rt.settings().checkpoint_interval > 0 || rt.restart_step()))
-    throw fsi::InputError(fmt::format(
-        "{}: the fluid on {} ranks writes no checkpoints yet; set output.checkpoint_interval = 0 "
-        "(it is {:g}) and start afresh, or run the fluid on 1 rank",
-        rt.scene().file().string(), rt.program_size(), rt.settings().checkpoint_interval));
   set_initial(*m_solver);
   const Grid& g = m_solver->grid();
   // Rank 0 writes the files; the diagnostics below are collective over the fluid's ranks.
@@ -270,13 +265,12 @@ nlohmann::json FluidProgram::flow_rate_report() const {
 
 // The solver's state, and the health check's (the diagnostics the coupler is sent).
 void FluidProgram::save(fsi::H5File& h5) const {
-  if (m_rt.program_size() > 1)
-    fsi::fail("the fluid on {} ranks writes no checkpoints yet (a stop asked for one); the "
-              "output written so far is kept",
-              m_rt.program_size());
-  m_solver->save(h5);
+  m_solver->save(&h5);
   h5.write("health", std::vector<double>{m_cfl, m_div, m_div_first, m_energy});
 }
+
+// The other ranks' part of a checkpoint: the solver's gathers, no file.
+void FluidProgram::save_ranks() const { m_solver->save(nullptr); }
 
 void FluidProgram::load(const fsi::H5File& h5) {
   m_solver->load(h5);

@@ -26,6 +26,7 @@ class FluidProgram : public fsi::FluidPort {
   std::string status() const override;
   nlohmann::json report() const override;
   void save(fsi::H5File& h5) const override;
+  void save_ranks() const override;
   void load(const fsi::H5File& h5) override;
 
  private:

@@ -110,7 +110,11 @@ class Solver {
   void project_initial();
   // Checkpoints (checkpoint.cpp): the state a step starts from, between steps: u, v, p with their
   // ghosts, the last step's explicit terms H^n (AB2), its dt, the clock, the boundaries' state.
-  void save(fsi::H5File& h5) const;
+  // The file holds the whole grid whatever the rank count (a run may resume on another): on
+  // several ranks save() gathers on rank 0, which passes the file (the others nullptr); load()
+  // reads the whole grid on every rank and keeps its rows.
+  void save(fsi::H5File* h5) const;
+  void save(fsi::H5File& h5) const { save(&h5); }
   void load(const fsi::H5File& h5);
 
   // First active u column (0 if x periodic, else 1) and v row.

@@ -84,15 +84,17 @@ def roles_of(bin_dir, scene):
     return re.search(r"^roles: (.*)$", out.stdout, re.M).group(1).split()
 
 
-def command(bin_dir, scene, args):
-    """The mpirun line of the programs a scene needs (fsi-plan), each given `args`."""
+def command(bin_dir, scene, args, fluid_ranks=1):
+    """The mpirun line of the programs a scene needs (fsi-plan), each given `args`; the fluid on
+    `fluid_ranks` ranks."""
     cmd = ["mpirun", "--oversubscribe"]
     if os.geteuid() == 0:
         cmd.append("--allow-run-as-root")
     for k, p in enumerate(roles_of(bin_dir, scene)):
         if k:
             cmd.append(":")
-        cmd += ["-n", "1", os.path.join(bin_dir, p), scene] + list(args)
+        n = fluid_ranks if p == "fluid" else 1
+        cmd += ["-n", str(n), os.path.join(bin_dir, p), scene] + list(args)
     return cmd
 
 

@@ -2,6 +2,7 @@
 """A run stopped and restarted equals a run straight through, bit for bit.
 
   restart_same.py --scene SCENE --t-end T --bin BIN --work DIR [--stop half|signal] [--extra TOML]
+                  [--fluid-ranks P] [--restart-ranks Q]
 
 The scene is written beside itself with t_end = T (and `extra` appended) for the run straight
 through; the stopped run is
@@ -13,6 +14,8 @@ through; the stopped run is
 Before the restart, a newer checkpoint folder that not every program completed is planted (a
 crash while writing): the restart must pass it by. With --change 'OLD=>NEW' a restart of the
 scene with that text replaced must first be refused with an error naming --key.
+--fluid-ranks runs the stopped run's fluid on P ranks, --restart-ranks the restart's on Q (the
+run straight through stays on one): a checkpoint holds the whole grid whatever the rank count.
 Compared: every CSV file byte for byte and every numeric HDF5 dataset (compare_outputs.py), and
 the XDMF files' step lists. Exits 1 naming the first difference, or when a run fails or a stop
 did not happen before T.
@@ -29,7 +32,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from compare_outputs import command, compare_dirs  # noqa: E402
+from compare_outputs import command, compare_dirs, roles_of  # noqa: E402
 
 
 def write_scene(scene, t_end, extra, tag, checkpoint_interval=None):
@@ -48,16 +51,17 @@ def write_scene(scene, t_end, extra, tag, checkpoint_interval=None):
     return path
 
 
-def run(bin_dir, scene, args, what):
-    r = subprocess.run(command(bin_dir, scene, args), capture_output=True, text=True, timeout=600)
+def run(bin_dir, scene, args, what, fluid_ranks=1):
+    r = subprocess.run(command(bin_dir, scene, args, fluid_ranks), capture_output=True, text=True,
+                       timeout=600)
     if r.returncode != 0:
         sys.exit(f"restart_same: the {what} failed (exit {r.returncode}):\n{r.stderr[-3000:]}")
     return r.stdout + r.stderr
 
 
-def stop_by_signal(bin_dir, scene, out):
+def stop_by_signal(bin_dir, scene, out, fluid_ranks=1):
     """Start the run, send SIGUSR1 to mpirun once the first checkpoint exists, wait for it."""
-    p = subprocess.Popen(command(bin_dir, scene, ["--out-dir", out, "--overwrite"]),
+    p = subprocess.Popen(command(bin_dir, scene, ["--out-dir", out, "--overwrite"], fluid_ranks),
                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     deadline = time.monotonic() + 300
     while not glob.glob(os.path.join(out, "checkpoint", "step_*", "coupler.h5")) and p.poll() is None:
@@ -89,6 +93,8 @@ def main():
     ap.add_argument("--extra", default="", help="TOML text appended to the scene (\\n: a new line)")
     ap.add_argument("--change", help="'OLD=>NEW': a scene text change the restart must refuse")
     ap.add_argument("--key", help="the key the refusal must name")
+    ap.add_argument("--fluid-ranks", type=int, default=1, help="the stopped run's fluid ranks")
+    ap.add_argument("--restart-ranks", type=int, help="the restart's fluid ranks (default: --fluid-ranks)")
     a = ap.parse_args()
     a.extra = a.extra.replace("\\n", "\n")
     scene = os.path.abspath(a.scene)
@@ -103,12 +109,12 @@ def main():
             half = write_scene(scene, a.t_end / 2, a.extra, "half", a.t_end / 2)
             made += [full, half]
             run(a.bin, full, ["--out-dir", straight, "--overwrite"], "run straight through")
-            run(a.bin, half, ["--out-dir", stopped, "--overwrite"], "run to T/2")
+            run(a.bin, half, ["--out-dir", stopped, "--overwrite"], "run to T/2", a.fluid_ranks)
         else:
             full = write_scene(scene, a.t_end, a.extra, "full", a.t_end / 4)
             made.append(full)
             run(a.bin, full, ["--out-dir", straight, "--overwrite"], "run straight through")
-            log = stop_by_signal(a.bin, full, stopped)
+            log = stop_by_signal(a.bin, full, stopped, a.fluid_ranks)
             steps = sorted(int(os.path.basename(p)[5:]) for p in glob.glob(os.path.join(stopped, "checkpoint", "step_*")))
             print(f"restart_same: stopped by the signal; checkpoints at steps {steps}")
             with open(os.path.join(stopped, "summary.json")) as f:
@@ -118,7 +124,9 @@ def main():
         partial = os.path.join(stopped, "checkpoint", "step_99999999")
         os.makedirs(partial)
         open(os.path.join(partial, "coupler.h5.tmp"), "w").write("cut short")
-        open(os.path.join(partial, "fluid.h5"), "w").write("not a checkpoint")
+        # (a scene of one program: its own file is the one cut short)
+        alone = roles_of(a.bin, full) == ["fluid"]
+        open(os.path.join(partial, "fluid.h5.tmp" if alone else "fluid.h5"), "w").write("not a checkpoint")
         if a.change:
             old, new = a.change.split("=>")
             text = open(full).read()
@@ -133,7 +141,7 @@ def main():
                 sys.exit(f"restart_same: the restart with {a.change} was not refused naming {a.key} "
                          f"(exit {r.returncode}):\n{r.stderr[-2000:]}")
             print(f"restart_same: a restart with {a.change} is refused naming {a.key}")
-        log = run(a.bin, full, ["--restart", stopped], "restart")
+        log = run(a.bin, full, ["--restart", stopped], "restart", a.restart_ranks or a.fluid_ranks)
         print(log.strip().splitlines()[-1] if log.strip() else "")
     finally:
         for p in made:
