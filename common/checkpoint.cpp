@@ -40,10 +40,12 @@ Toml parse_toml(const std::string& text, const std::string& name) {
   return toml::parse<toml::discard_comments, std::map, std::vector>(is, name);
 }
 
-// Keys a restart may change: the run's length, its output and the test switches.
+// Keys a restart may change: the run's length, its output, the test switches and the fluid's
+// rank count (a checkpoint holds the whole grid).
 bool may_change(const std::string& path) {
   return path == "time.t_end" || path == "output" || path.starts_with("output.") ||
-         path == "scene.description" || path == "test" || path.starts_with("test.");
+         path == "scene.description" || path == "test" || path.starts_with("test.") ||
+         path == "fluid.ranks";
 }
 
 std::string first_difference(const Toml& a, const Toml& b, const std::string& path) {

@@ -19,11 +19,13 @@
 namespace fsi::proto {
 
 // Bump on any change of a message's layout or of the message order.
-inline constexpr std::int32_t kVersion = 8;
+inline constexpr std::int32_t kVersion = 7;
 inline constexpr std::uint32_t kMagic = 0x4d495346;  // "FSIM"
 
-// The fluid on several ranks (since version 8): its ny cell rows in blocks of this many, rank r
-// holding rows [r b, min((r + 1) b, ny)) (FFTW's split; PROTOCOL.md, "The fluid on several ranks").
+// The fluid on several ranks: its ny cell rows in blocks of this many, rank r holding rows
+// [r b, min((r + 1) b, ny)) (FFTW's split; PROTOCOL.md, "The fluid on several ranks"). One rank
+// changes nothing of the protocol, so its version stays: a program of an older version refuses
+// a fluid of several ranks at the handshake.
 inline int fluid_row_block(int ny, int ranks) { return (ny + ranks - 1) / ranks; }
 
 // 64-bit FNV-1a of bytes: the handshake's scene and output-options hashes (PROTOCOL.md,

@@ -41,8 +41,7 @@ class Boundaries {
   // d: the rows this process holds (its loops run over them; sums over the sides are taken
   // over all ranks, in the same order of collectives on every rank).
   // d must outlive the Boundaries (the solver's own).
-  Boundaries(const Grid& g, const std::array<SideBc, 4>& bc,
-             const Decomposition& d = whole_grid());
+  Boundaries(const Grid& g, const std::array<SideBc, 4>& bc, const Decomposition& d);
   const SideBc& side(int s) const { return m_bc[s]; }
   const GhostRule& rule(int s) const { return m_rule[s]; }
   bool has_outflow() const { return m_has_outflow; }

@@ -74,7 +74,7 @@ struct Config {
   bool implicit = false;     // Crank-Nicolson diffusion (else explicit AB2)
   // Weight of first-order upwind in the convective fluxes outside the sponge (0: central).
   double upwind_blend = 0;
-  int ranks = 1;  // [fluid] ranks: the ranks ./fsi launches the fluid on (the launcher's key)
+  int ranks = 0;  // [fluid] ranks: the ranks ./fsi launches the fluid on (0: not given)
   // Body force per unit volume f(t) = body + oscillating sin(2 pi t / period + phase) (Eq. 29
   // with body = 0), plus rho g.
   std::array<double, 2> body{0, 0}, oscillating{0, 0}, gravity{0, 0};

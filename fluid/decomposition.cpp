@@ -11,26 +11,21 @@
 
 namespace fluid {
 
-Decomposition::Decomposition(MPI_Comm comm, int ny, bool periodic_y)
+Decomposition::Decomposition(MPI_Comm comm, int ny, bool periodic_y, const std::string& what)
     : m_comm(comm), m_ny(ny), m_lo(0), m_hi(ny), m_block(ny), m_periodic(periodic_y) {
   if (comm == MPI_COMM_NULL) return;
   MPI_Comm_size(comm, &m_ranks);
   MPI_Comm_rank(comm, &m_rank);
   if (m_ranks == 1) return;
-  const RowSplit s = split_rows(ny, m_ranks, m_rank);
-  m_lo = s.lo, m_hi = s.hi, m_block = s.block;
   // The wall ghosts of u use the first two rows; a stencil reads one row beyond the slab.
-  const int last = ny - s.lo_of(m_ranks - 1);
-  if (last < 2)
+  try {
+    const RowSplit s = split_rows(ny, m_ranks, m_rank, 2);
+    m_lo = s.lo, m_hi = s.hi, m_block = s.block;
+  } catch (const fsi::InputError& e) {
     throw fsi::InputError(fmt::format(
-        "the fluid's {} cell rows over {} ranks leave the last rank {} row(s) (blocks of {}); each "
-        "rank needs at least 2: use fewer ranks",
-        ny, m_ranks, last, s.block));
-}
-
-const Decomposition& whole_grid() {
-  static const Decomposition d;
-  return d;
+        "{} {} (the fluid's ranks: mpirun -n, [fluid] ranks or ./fsi run --fluid-ranks)", what,
+        e.what()));
+  }
 }
 
 int Decomposition::owner(int j) const {

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <string>
 #include <vector>
 
 #include "field.hpp"
@@ -17,10 +18,10 @@ namespace fluid {
 
 class Decomposition {
  public:
-  Decomposition() = default;  // one rank, the whole grid
   // Rows of a grid of ny cell rows split over the ranks of comm (MPI_COMM_NULL: one rank).
-  // Throws fsi::InputError when a rank would hold fewer than two rows.
-  Decomposition(MPI_Comm comm, int ny, bool periodic_y);
+  // Throws fsi::InputError when a rank would hold fewer than two rows, its message beginning
+  // with `what` (the grid's key and file) and naming the rank counts that fit.
+  Decomposition(MPI_Comm comm, int ny, bool periodic_y, const std::string& what = "the fluid's");
 
   bool serial() const { return m_ranks == 1; }
   int rank() const { return m_rank; }
@@ -81,8 +82,5 @@ class Decomposition {
   bool m_periodic = false;
   mutable Traffic m_traffic;
 };
-
-// The one-rank decomposition, for who holds a reference to one without a split.
-const Decomposition& whole_grid();
 
 }  // namespace fluid

@@ -16,6 +16,12 @@ FluidProgram::FluidProgram(fsi::Runtime& rt)
     : m_rt(rt),
       m_cfg(read_config(rt.root().table("fluid"), rt.settings().dt)),
       m_solver(std::make_unique<Solver>(m_cfg, rt.settings().dt, rt.program_comm())) {
+  if (rt.is_root() && m_cfg.ranks > 0 && m_cfg.ranks != rt.program_size())
+    std::fprintf(stderr,
+                 "[fluid] warning: fluid.ranks = %d in %s, but the job launched the fluid on %d "
+                 "rank(s): running on %d (the job's count decides)\n",
+                 m_cfg.ranks, rt.scene().file().string().c_str(), rt.program_size(),
+                 rt.program_size());
   set_initial(*m_solver);
   const Grid& g = m_solver->grid();
   // Rank 0 writes the files; the diagnostics below are collective over the fluid's ranks.

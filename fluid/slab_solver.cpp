@@ -68,7 +68,7 @@ int ceil_div(int a, int b) { return (a + b - 1) / b; }
 int RowSplit::lo_of(int r) const { return std::min(rows, r * block); }
 int RowSplit::hi_of(int r) const { return std::min(rows, (r + 1) * block); }
 
-RowSplit split_rows(int rows, int ranks, int rank) {
+RowSplit split_rows(int rows, int ranks, int rank, int min_rows) {
   if (ranks < 1 || rank < 0 || rank >= ranks)
     fsi::fail("fluid: rank {} of {} ranks", rank, ranks);
   RowSplit s;
@@ -76,18 +76,18 @@ RowSplit split_rows(int rows, int ranks, int rank) {
   s.ranks = ranks;
   s.rank = rank;
   s.block = fsi::proto::fluid_row_block(rows, ranks);
-  // Blocks of ceil(rows / P): the last rank holds what is left, and must hold a row.
-  if (s.block * (ranks - 1) >= rows) {
-    auto fits = [&](int p) { return ceil_div(rows, p) * (p - 1) < rows; };
+  // Blocks of ceil(rows / P): the last rank holds what is left, at least min_rows.
+  auto last = [&](int p) { return rows - fsi::proto::fluid_row_block(rows, p) * (p - 1); };
+  if (last(ranks) < min_rows) {
     int below = ranks - 1, above = ranks + 1;
-    while (below > 1 && !fits(below)) --below;
-    while (above <= rows && !fits(above)) ++above;
+    while (below > 1 && last(below) < min_rows) --below;
+    while (above <= rows && last(above) < min_rows) ++above;
     const std::string other = above <= rows ? fmt::format("{} or {}", below, above)
                                             : fmt::format("{}", below);
     throw fsi::InputError(fmt::format(
-        "the fluid's {} cell rows cannot be split over {} ranks (blocks of {} rows leave the last "
-        "rank none); {} ranks would do",
-        rows, ranks, s.block, other));
+        "{} cell rows cannot be split over {} ranks: blocks of {} rows leave the last rank {} "
+        "(each needs {}); {} ranks would do",
+        rows, ranks, s.block, std::max(0, last(ranks)), min_rows, other));
   }
   s.lo = s.lo_of(rank);
   s.hi = s.hi_of(rank);

@@ -39,8 +39,9 @@ struct RowSplit {
   int lo_of(int r) const;
   int hi_of(int r) const;
 };
-// Throws fsi::Error (saying how many ranks fit) when a rank would get no row.
-RowSplit split_rows(int rows, int ranks, int rank);
+// Throws fsi::InputError, naming the nearest rank counts that fit, when the last rank would get
+// fewer than min_rows rows.
+RowSplit split_rows(int rows, int ranks, int rank, int min_rows = 1);
 
 class SlabSolver {
  public:
@@ -55,7 +56,7 @@ class SlabSolver {
   const RowSplit& split() const { return m_split; }
   int row_length() const { return m_nx; }  // unknowns per row (x)
   // This rank's rows [split().lo, split().hi), x fastest: right-hand side in, solution out.
-  // A padded row (global row < pad) is ignored on input and left as it is on output.
+  // A padded row (global row < pad) is ignored on input and returned as zero.
   double* data() { return m_buf; }
   void solve();
   // The transposes so far: their count, wall seconds and the bytes this rank sent to others.

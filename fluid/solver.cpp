@@ -3,6 +3,8 @@
 // steps themselves are in predictor.cpp, forcing.cpp and projection.cpp.
 #include "solver.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <numbers>
 
@@ -104,7 +106,9 @@ Solver::Solver(const Config& c, double dt, MPI_Comm comm)
             y.periodic = c.bc[bottom].type == BcType::periodic;
             return y;
           }()),
-      m_dec(comm, m_grid.ny(), m_grid.y().periodic()),
+      m_dec(comm, m_grid.ny(), m_grid.y().periodic(),
+            fmt::format("fluid.grid.cells = [{}, {}] (in {}): its", c.x.cells, c.y.cells,
+                        c.source)),
       m_bnd(m_grid, c.bc, m_dec),
       m_sponge(sponge_weights(m_grid, c.upwind_blend)) {
   validate(c, dt);

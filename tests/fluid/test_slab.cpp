@@ -131,11 +131,15 @@ TEST_CASE("slab solver with both directions transformed", "[fluid][slab]") {
   }
 }
 
-TEST_CASE("a split that leaves a rank no row is refused", "[fluid][slab]") {
+TEST_CASE("a split that leaves a rank too few rows is refused", "[fluid][slab]") {
   CHECK_THROWS_WITH(split_rows(9, 4, 0),
-                    Catch::Contains("cannot be split over 4 ranks") &&
+                    Catch::Contains("9 cell rows cannot be split over 4 ranks") &&
                         Catch::Contains("3 or 5 ranks would do"));
-  const RowSplit s = split_rows(10, 3, 2);
+  // The fluid's minimum of two rows: 5 ranks would leave the last one row.
+  CHECK_THROWS_WITH(split_rows(9, 4, 0, 2), Catch::Contains("; 3 ranks would do"));
+  CHECK_THROWS_WITH(split_rows(10, 4, 0, 2),
+                    Catch::Contains("leave the last rank 1 (each needs 2); 3 or 5 ranks would do"));
+  const RowSplit s = split_rows(10, 3, 2, 2);
   CHECK(s.block == 4);
   CHECK(s.lo == 8);
   CHECK(s.hi == 10);
