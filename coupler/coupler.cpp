@@ -324,14 +324,20 @@ void Coupler::finish(long steps, long first) {
     // fluid's diagnostics are the whole grid's on every rank), with the count of ranks.
     auto& links = m_rt.links(r);
     for (auto& l : links) l->send(stop, steps);
+    nlohmann::json traffic = nlohmann::json::array();
     for (std::size_t k = 0; k < links.size(); ++k) {
       proto::Text report{proto::Tag::final_report, {}};
       links[k]->recv(report);
-      if (k > 0) continue;
       auto part = nlohmann::json::parse(report.text);
-      if (links.size() > 1) part["ranks"] = links.size();
+      // Per rank: the bytes it received from and sent to the coupler (its share of the traffic).
+      traffic.push_back({{"received", part["bytes_received"]}, {"sent", part["bytes_sent"]}});
+      if (k > 0) continue;
       j["wall_time"][fsi::role_name(r)] = part["wall_time"];
       j[fsi::role_name(r)] = part;
+    }
+    if (links.size() > 1) {
+      j[fsi::role_name(r)]["ranks"] = links.size();
+      j[fsi::role_name(r)]["bytes_per_rank"] = traffic;
     }
   }
   const double loop = std::max(m_rt.wall_seconds() - m_t_start, kMinLoopSeconds);
