@@ -8,14 +8,8 @@
 #include "error.hpp"
 
 namespace fluid {
-namespace {
 
-struct Kinds {
-  fftw_r2r_kind fwd, bwd;
-  double norm;  // backward(forward(x)) = norm * x
-};
-
-Kinds kinds_for(int n, Closure lo, Closure hi) {
+TransformPair transform_pair(int n, Closure lo, Closure hi) {
   using C = Closure;
   if (lo == C::periodic && hi == C::periodic) return {FFTW_R2HC, FFTW_HC2R, double(n)};
   if (lo == C::dirichlet_node && hi == C::dirichlet_node)
@@ -30,7 +24,47 @@ Kinds kinds_for(int n, Closure lo, Closure hi) {
   fsi::fail("fluid::FastSolver: no real transform for this pair of closures");
 }
 
-}  // namespace
+int thomas_factors(const Operator1D& s, const std::vector<double>& lt, double sigma, int k0,
+                   int cols, std::vector<double>& inv_piv, std::vector<double>& gamma) {
+  const int ns = s.n;
+  inv_piv.assign(std::size_t(cols) * ns, 0);
+  gamma.assign(std::size_t(cols) * ns, 0);
+  int zero_col = -1;
+  for (int col = 0; col < cols; ++col) {
+    const int k = k0 + col;
+    if (k < 0) continue;
+    const bool zero = sigma == 0.0 && lt[k] == 0.0 && s.singular;
+    if (zero) zero_col = col;
+    double gprev = 0;
+    for (int j = 0; j < ns; ++j) {
+      const double piv = s.b[j] + lt[k] - sigma - s.a[j] * gprev;
+      const std::size_t q = col + std::size_t(cols) * j;
+      const bool last = j == ns - 1;
+      inv_piv[q] = (zero && last) ? 0.0 : 1.0 / piv;
+      gamma[q] = last ? 0.0 : s.c[j] / piv;
+      gprev = gamma[q];
+    }
+  }
+  return zero_col;
+}
+
+void thomas_sweep(double* x, int cols, int col_first, int ns, const double* a,
+                  const double* inv_piv, const double* gamma, double inv_norm) {
+  for (int c = col_first; c < cols; ++c) x[c] *= inv_norm * inv_piv[c];
+  for (int j = 1; j < ns; ++j) {
+    double* xj = x + std::size_t(cols) * j;
+    const double* xm = xj - cols;
+    const double* ip = inv_piv + std::size_t(cols) * j;
+    const double aj = a[j];
+    for (int c = col_first; c < cols; ++c) xj[c] = (xj[c] * inv_norm - aj * xm[c]) * ip[c];
+  }
+  for (int j = ns - 2; j >= 0; --j) {
+    double* xj = x + std::size_t(cols) * j;
+    const double* xp = xj + cols;
+    const double* g = gamma + std::size_t(cols) * j;
+    for (int c = col_first; c < cols; ++c) xj[c] -= g[c] * xp[c];
+  }
+}
 
 // lambda_k = -(4 / h^2) sin^2(theta_k / 2), theta_k the angle of mode k:
 //   periodic 2 pi k / n, dirichlet_node pi (k+1) / (n+1), neumann_half pi k / n,
@@ -64,11 +98,11 @@ FastSolver::FastSolver(const Operator1D& t, const Operator1D& s, double sigma)
   const std::size_t size = std::size_t(m_nt) * m_ns;
   m_buf = fftw_alloc_real(size);
   for (std::size_t q = 0; q < size; ++q) m_buf[q] = 0;
-  const Kinds kt = kinds_for(m_nt, t.lo, t.hi);
+  const TransformPair kt = transform_pair(m_nt, t.lo, t.hi);
   const std::vector<double> lt = eigenvalues(m_nt, t.h, t.lo, t.hi);
   // FFTW_ESTIMATE: the plan does not depend on timings, so two runs are bit-identical.
   if (m_transform_s) {
-    const Kinds ks = kinds_for(m_ns, s.lo, s.hi);
+    const TransformPair ks = transform_pair(m_ns, s.lo, s.hi);
     m_fwd = fftw_plan_r2r_2d(m_ns, m_nt, m_buf, m_buf, ks.fwd, kt.fwd, FFTW_ESTIMATE);
     m_bwd = fftw_plan_r2r_2d(m_ns, m_nt, m_buf, m_buf, ks.bwd, kt.bwd, FFTW_ESTIMATE);
     m_norm = kt.norm * ks.norm;
@@ -92,22 +126,7 @@ FastSolver::FastSolver(const Operator1D& t, const Operator1D& s, double sigma)
     // Thomas factors of (a, b + lambda_k - sigma, c) for every wavenumber k; the
     // normalisation of the transform pair is folded into the first pivot's right-hand side.
     m_a = s.a;
-    m_inv_piv.assign(size, 0);
-    m_gamma.assign(size, 0);
-    for (int k = 0; k < m_nt; ++k) {
-      const bool zero = sigma == 0.0 && lt[k] == 0.0 && s.singular;
-      if (zero) m_zero_mode = k;
-      double gprev = 0;
-      for (int j = 0; j < m_ns; ++j) {
-        const double piv = s.b[j] + lt[k] - sigma - s.a[j] * gprev;
-        const std::size_t q = k + std::size_t(m_nt) * j;
-        const bool last = j == m_ns - 1;
-        // A singular problem's last pivot is zero: fixing that unknown to 0 picks one solution.
-        m_inv_piv[q] = (zero && last) ? 0.0 : 1.0 / piv;
-        m_gamma[q] = last ? 0.0 : s.c[j] / piv;
-        gprev = m_gamma[q];
-      }
-    }
+    m_zero_mode = thomas_factors(s, lt, sigma, 0, m_nt, m_inv_piv, m_gamma);
   }
   if (!m_fwd || !m_bwd) fsi::fail("fluid::FastSolver: FFTW could not plan the transforms");
 }
@@ -136,24 +155,7 @@ void FastSolver::tridiagonal() {
     for (std::size_t q = 0; q < size; ++q) x[q] *= e[q];
     return;
   }
-  const double inv_norm = 1.0 / m_norm;
-  {
-    const double* ip = m_inv_piv.data();
-    for (int k = 0; k < nt; ++k) x[k] *= inv_norm * ip[k];
-  }
-  for (int j = 1; j < ns; ++j) {
-    double* xj = x + std::size_t(nt) * j;
-    const double* xm = xj - nt;
-    const double* ip = m_inv_piv.data() + std::size_t(nt) * j;
-    const double aj = m_a[j];
-    for (int k = 0; k < nt; ++k) xj[k] = (xj[k] * inv_norm - aj * xm[k]) * ip[k];
-  }
-  for (int j = ns - 2; j >= 0; --j) {
-    double* xj = x + std::size_t(nt) * j;
-    const double* xp = xj + nt;
-    const double* g = m_gamma.data() + std::size_t(nt) * j;
-    for (int k = 0; k < nt; ++k) xj[k] -= g[k] * xp[k];
-  }
+  thomas_sweep(x, nt, 0, ns, m_a.data(), m_inv_piv.data(), m_gamma.data(), 1.0 / m_norm);
   // Remove the weighted mean of the singular mode's line (the t-mean of the solution).
   if (m_zero_mode >= 0 && !m_weights.empty()) {
     double sw = 0, s = 0;

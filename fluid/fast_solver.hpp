@@ -34,6 +34,25 @@ struct Operator1D {
 // transform that diagonalises it (halfcomplex order for periodic).
 std::vector<double> eigenvalues(int n, double h, Closure lo, Closure hi);
 
+// The real transform pair that diagonalises that operator: backward(forward(x)) = norm x.
+struct TransformPair {
+  fftw_r2r_kind fwd, bwd;
+  double norm;
+};
+TransformPair transform_pair(int n, Closure lo, Closure hi);
+
+// The Thomas factors of (a, b + lambda_k - sigma, c) along s for the wavenumbers k = k0 + col,
+// col in [0, cols), stored per (j, col) with col fastest: inverse pivots and gammas (resized).
+// Columns with k < 0 (padded rows of a slab) stay zero. A singular problem's zero mode
+// (sigma = 0, lambda_k = 0, s singular) gets a zero last inverse pivot, which picks one solution.
+// Returns that mode's column, or -1.
+int thomas_factors(const Operator1D& s, const std::vector<double>& lt, double sigma, int k0,
+                   int cols, std::vector<double>& inv_piv, std::vector<double>& gamma);
+// Forward elimination and back substitution on x[col + cols j], j in [0, ns), for the columns
+// [col_first, cols), the right-hand side scaled by inv_norm: vectorised across the columns.
+void thomas_sweep(double* x, int cols, int col_first, int ns, const double* a,
+                  const double* inv_piv, const double* gamma, double inv_norm);
+
 class FastSolver {
  public:
   // t: the transform direction's operator (uniform); s: the other one. When s.lo is periodic,

@@ -10,28 +10,6 @@
 namespace fluid {
 namespace {
 
-struct Kinds {
-  fftw_r2r_kind fwd, bwd;
-  double norm;
-};
-
-// The real transform pair that diagonalises a uniform 1D operator with these closures, and
-// backward(forward(x)) = norm x (as fast_solver.cpp).
-Kinds kinds_for(int n, Closure lo, Closure hi) {
-  using C = Closure;
-  if (lo == C::periodic && hi == C::periodic) return {FFTW_R2HC, FFTW_HC2R, double(n)};
-  if (lo == C::dirichlet_node && hi == C::dirichlet_node)
-    return {FFTW_RODFT00, FFTW_RODFT00, 2.0 * (n + 1)};
-  if (lo == C::neumann_half && hi == C::neumann_half) return {FFTW_REDFT10, FFTW_REDFT01, 2.0 * n};
-  if (lo == C::dirichlet_half && hi == C::dirichlet_half)
-    return {FFTW_RODFT10, FFTW_RODFT01, 2.0 * n};
-  if (lo == C::dirichlet_half && hi == C::neumann_half)
-    return {FFTW_RODFT11, FFTW_RODFT11, 2.0 * n};
-  if (lo == C::neumann_half && hi == C::dirichlet_half)
-    return {FFTW_REDFT11, FFTW_REDFT11, 2.0 * n};
-  fsi::fail("fluid::SlabSolver: no real transform for this pair of closures");
-}
-
 // count lines of length n, `stride` apart within a line and `dist` apart from line to line.
 fftw_plan lines_plan(int n, int count, double* p, int stride, int dist, fftw_r2r_kind kind) {
   if (count <= 0 || n <= 0) return nullptr;
@@ -136,7 +114,7 @@ SlabSolver::SlabSolver(const Operator1D& t, const Operator1D& s, double sigma, i
   // A transpose sends this rank's values but its own block: about (P - 1) / P of its share.
   m_bytes_per_transpose = 8.0 * double(rows) * ncol / ranks * (ranks - 1) / ranks;
 
-  const Kinds kt = kinds_for(m_nt, t.lo, t.hi);
+  const TransformPair kt = transform_pair(m_nt, t.lo, t.hi);
   m_lt = eigenvalues(m_nt, t.h, t.lo, t.hi);
   m_norm = kt.norm;
   int stride;  // the local wavenumbers' count in the layout of the solve along s
@@ -168,7 +146,7 @@ SlabSolver::SlabSolver(const Operator1D& t, const Operator1D& s, double sigma, i
   double* base = m_buf + (t_axis == 0 ? std::size_t(pad) * stride : 0);
   const std::size_t lsize = std::size_t(stride) * m_ns;
   if (m_transform_s) {
-    const Kinds ks = kinds_for(m_ns, s.lo, s.hi);
+    const TransformPair ks = transform_pair(m_ns, s.lo, s.hi);
     m_s_fwd = lines_plan(m_ns, stride, base, stride, 1, ks.fwd);
     m_s_bwd = lines_plan(m_ns, stride, base, stride, 1, ks.bwd);
     m_ls = eigenvalues(m_ns, s.h, s.lo, s.hi);
@@ -185,22 +163,7 @@ SlabSolver::SlabSolver(const Operator1D& t, const Operator1D& s, double sigma, i
   } else {
     // Thomas factors of (a, b + lambda_k - sigma, c) per local wavenumber, as FastSolver's.
     m_a = s.a;
-    m_inv_piv.assign(lsize, 0);
-    m_gamma.assign(lsize, 0);
-    for (int c = 0; c < stride; ++c) {
-      const int k = m_k0 + c;
-      if (k < 0) continue;
-      const bool zero = sigma == 0.0 && m_lt[k] == 0.0 && s.singular;
-      double gprev = 0;
-      for (int j = 0; j < m_ns; ++j) {
-        const double piv = s.b[j] + m_lt[k] - sigma - s.a[j] * gprev;
-        const std::size_t q = c + std::size_t(stride) * j;
-        const bool last = j == m_ns - 1;
-        m_inv_piv[q] = (zero && last) ? 0.0 : 1.0 / piv;
-        m_gamma[q] = last ? 0.0 : s.c[j] / piv;
-        gprev = m_gamma[q];
-      }
-    }
+    thomas_factors(s, m_lt, sigma, m_k0, stride, m_inv_piv, m_gamma);
   }
 }
 
@@ -257,24 +220,7 @@ void SlabSolver::lines() {
     run(m_s_bwd);
     return;
   }
-  const double inv_norm = 1.0 / m_norm;
-  {
-    const double* ip = m_inv_piv.data();
-    for (int c = c_first; c < stride; ++c) x[c] *= inv_norm * ip[c];
-  }
-  for (int j = 1; j < ns; ++j) {
-    double* xj = x + std::size_t(stride) * j;
-    const double* xm = xj - stride;
-    const double* ip = m_inv_piv.data() + std::size_t(stride) * j;
-    const double aj = m_a[j];
-    for (int c = c_first; c < stride; ++c) xj[c] = (xj[c] * inv_norm - aj * xm[c]) * ip[c];
-  }
-  for (int j = ns - 2; j >= 0; --j) {
-    double* xj = x + std::size_t(stride) * j;
-    const double* xp = xj + stride;
-    const double* g = m_gamma.data() + std::size_t(stride) * j;
-    for (int c = c_first; c < stride; ++c) xj[c] -= g[c] * xp[c];
-  }
+  thomas_sweep(x, stride, c_first, ns, m_a.data(), m_inv_piv.data(), m_gamma.data(), 1.0 / m_norm);
   // The singular mode's line: remove its weighted mean (it is whole on this rank).
   if (m_sigma == 0.0 && m_singular && !m_weights.empty()) {
     for (int c = c_first; c < stride; ++c) {

@@ -2,7 +2,7 @@
 """Run scenes with the fluid on 1 rank and on P ranks and check that the outputs agree to
 round-off.
 
-  ranks.py --bin BIN --work DIR --ranks P [--programs fluid,solid,coupler] [--t-end T]
+  ranks.py --bin BIN --work DIR --ranks P[,Q...] [--programs fluid,solid,coupler] [--t-end T]
            [--tolerance 1e-12] -- MPIEXEC... SCENE.toml...
 
 Every scene runs as `MPIEXEC -n 1 BIN/fluid SCENE [: -n 1 BIN/solid SCENE ...]` and with `-n P`
@@ -55,7 +55,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--bin", required=True)
     ap.add_argument("--work", required=True)
-    ap.add_argument("--ranks", type=int, required=True)
+    ap.add_argument("--ranks", required=True, help="P, or several: 2,3 (each against one rank)")
     ap.add_argument("--programs", default="fluid")
     ap.add_argument("--t-end", type=float)
     ap.add_argument("--tolerance", type=float, default=1e-12)
@@ -68,9 +68,10 @@ def main():
         sys.exit("ranks: give the mpiexec command and at least one scene after --")
     programs = a.programs.split(",")
     worst_all, failures = 0.0, []
+    counts = [int(x) for x in a.ranks.split(",")]
     for scene in scenes:
         name = os.path.splitext(os.path.basename(scene))[0]
-        one, many = (os.path.join(a.work, f"{name}-{p}") for p in (1, a.ranks))
+        one = os.path.join(a.work, f"{name}-1")
         copy = None
         if a.t_end is not None:
             text, n = re.subn(r"(?m)^t_end\s*=.*$", f"t_end = {a.t_end!r}", open(scene).read(), count=1)
@@ -81,32 +82,36 @@ def main():
                 f.write(text)
         try:
             run(mpiexec, a.bin, programs, 1, copy or scene, one)
-            run(mpiexec, a.bin, programs, a.ranks, copy or scene, many)
+            for p in counts:
+                run(mpiexec, a.bin, programs, p, copy or scene, os.path.join(a.work, f"{name}-{p}"))
         finally:
             if copy:
                 os.remove(copy)
-        kinds = {}
-        for h5 in sorted(glob.glob(os.path.join(one, "*.h5"))):
-            other = os.path.join(many, os.path.basename(h5))
-            d1 = datasets(h5)
-            dp = datasets(other) if os.path.exists(other) else {}
-            if sorted(d1) != sorted(dp):
-                failures.append(f"{name}: the runs wrote different datasets in {os.path.basename(h5)}")
-                continue
-            for key in d1:
-                kind = os.path.basename(h5)[:-3] + ":" + key.split("/")[-1]
-                kinds[kind] = max(kinds.get(kind, 0.0), relative(d1[key], dp[key]))
-        for csv in sorted(glob.glob(os.path.join(one, "*.csv"))):
-            x = np.loadtxt(csv, delimiter=",", skiprows=1, ndmin=2)
-            y = np.loadtxt(os.path.join(many, os.path.basename(csv)), delimiter=",", skiprows=1, ndmin=2)
-            kinds[os.path.basename(csv)] = relative(x, y)
-        if not kinds:
-            failures.append(f"{name}: nothing compared")
-        for kind, d in sorted(kinds.items()):
-            print(f"{name}: {kind:32s} largest relative difference {d:.3g}")
-            worst_all = max(worst_all, d)
-            if not d <= a.tolerance:
-                failures.append(f"{name}: {kind} differs by {d:.3g} (tolerance {a.tolerance:g})")
+        for p in counts:
+            many = os.path.join(a.work, f"{name}-{p}")
+            kinds = {}
+            for h5 in sorted(glob.glob(os.path.join(one, "*.h5"))):
+                other = os.path.join(many, os.path.basename(h5))
+                d1 = datasets(h5)
+                dp = datasets(other) if os.path.exists(other) else {}
+                if sorted(d1) != sorted(dp):
+                    failures.append(f"{name}: the runs on 1 and {p} ranks wrote different datasets in "
+                                    f"{os.path.basename(h5)}")
+                    continue
+                for key in d1:
+                    kind = os.path.basename(h5)[:-3] + ":" + key.split("/")[-1]
+                    kinds[kind] = max(kinds.get(kind, 0.0), relative(d1[key], dp[key]))
+            for csv in sorted(glob.glob(os.path.join(one, "*.csv"))):
+                x = np.loadtxt(csv, delimiter=",", skiprows=1, ndmin=2)
+                y = np.loadtxt(os.path.join(many, os.path.basename(csv)), delimiter=",", skiprows=1, ndmin=2)
+                kinds[os.path.basename(csv)] = relative(x, y)
+            if not kinds:
+                failures.append(f"{name}: nothing compared")
+            for kind, d in sorted(kinds.items()):
+                print(f"{name} on {p} ranks: {kind:32s} largest relative difference {d:.3g}")
+                worst_all = max(worst_all, d)
+                if not d <= a.tolerance:
+                    failures.append(f"{name} on {p} ranks: {kind} differs by {d:.3g} (tolerance {a.tolerance:g})")
     print(f"largest relative difference, 1 against {a.ranks} ranks: {worst_all:.3g}")
     if failures:
         sys.exit("ranks: " + "; ".join(failures))
