@@ -66,6 +66,16 @@ void thomas_sweep(double* x, int cols, int col_first, int ns, const double* a,
   }
 }
 
+void remove_weighted_mean(double* x, int cols, int col, int ns, const std::vector<double>& w) {
+  double sw = 0, s = 0;
+  for (int j = 0; j < ns; ++j) {
+    sw += w[j];
+    s += w[j] * x[col + std::size_t(cols) * j];
+  }
+  const double mean = s / sw;
+  for (int j = 0; j < ns; ++j) x[col + std::size_t(cols) * j] -= mean;
+}
+
 // lambda_k = -(4 / h^2) sin^2(theta_k / 2), theta_k the angle of mode k:
 //   periodic 2 pi k / n, dirichlet_node pi (k+1) / (n+1), neumann_half pi k / n,
 //   dirichlet_half pi (k+1) / n, mixed half closures pi (k + 1/2) / n.
@@ -157,15 +167,7 @@ void FastSolver::tridiagonal() {
   }
   thomas_sweep(x, nt, 0, ns, m_a.data(), m_inv_piv.data(), m_gamma.data(), 1.0 / m_norm);
   // Remove the weighted mean of the singular mode's line (the t-mean of the solution).
-  if (m_zero_mode >= 0 && !m_weights.empty()) {
-    double sw = 0, s = 0;
-    for (int j = 0; j < ns; ++j) {
-      sw += m_weights[j];
-      s += m_weights[j] * x[m_zero_mode + std::size_t(nt) * j];
-    }
-    const double mean = s / sw;
-    for (int j = 0; j < ns; ++j) x[m_zero_mode + std::size_t(nt) * j] -= mean;
-  }
+  if (m_zero_mode >= 0 && !m_weights.empty()) remove_weighted_mean(x, nt, m_zero_mode, ns, m_weights);
 }
 
 void FastSolver::solve() {

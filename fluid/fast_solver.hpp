@@ -52,6 +52,9 @@ int thomas_factors(const Operator1D& s, const std::vector<double>& lt, double si
 // [col_first, cols), the right-hand side scaled by inv_norm: vectorised across the columns.
 void thomas_sweep(double* x, int cols, int col_first, int ns, const double* a,
                   const double* inv_piv, const double* gamma, double inv_norm);
+// Column `col` of x[col + cols j], j in [0, ns): its mean weighted by w[j] subtracted (the zero
+// mode of a singular problem, whose solution is fixed up to a constant).
+void remove_weighted_mean(double* x, int cols, int col, int ns, const std::vector<double>& w);
 
 class FastSolver {
  public:

@@ -80,8 +80,6 @@ SlabSolver::SlabSolver(const Operator1D& t, const Operator1D& s, double sigma, i
       m_nt(t.n),
       m_ns(s.n),
       m_transform_s(s.lo == Closure::periodic),
-      m_sigma(sigma),
-      m_singular(s.singular),
       m_comm(comm) {
   static const bool initialised = [] {
     fftw_mpi_init();
@@ -163,7 +161,7 @@ SlabSolver::SlabSolver(const Operator1D& t, const Operator1D& s, double sigma, i
   } else {
     // Thomas factors of (a, b + lambda_k - sigma, c) per local wavenumber, as FastSolver's.
     m_a = s.a;
-    thomas_factors(s, m_lt, sigma, m_k0, stride, m_inv_piv, m_gamma);
+    m_zero_col = thomas_factors(s, m_lt, sigma, m_k0, stride, m_inv_piv, m_gamma);
   }
 }
 
@@ -222,18 +220,7 @@ void SlabSolver::lines() {
   }
   thomas_sweep(x, stride, c_first, ns, m_a.data(), m_inv_piv.data(), m_gamma.data(), 1.0 / m_norm);
   // The singular mode's line: remove its weighted mean (it is whole on this rank).
-  if (m_sigma == 0.0 && m_singular && !m_weights.empty()) {
-    for (int c = c_first; c < stride; ++c) {
-      if (m_lt[m_k0 + c] != 0.0) continue;
-      double sw = 0, s = 0;
-      for (int j = 0; j < ns; ++j) {
-        sw += m_weights[j];
-        s += m_weights[j] * x[c + std::size_t(stride) * j];
-      }
-      const double mean = s / sw;
-      for (int j = 0; j < ns; ++j) x[c + std::size_t(stride) * j] -= mean;
-    }
-  }
+  if (m_zero_col >= 0 && !m_weights.empty()) remove_weighted_mean(x, stride, m_zero_col, ns, m_weights);
 }
 
 }  // namespace fluid

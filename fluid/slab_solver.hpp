@@ -85,8 +85,7 @@ class SlabSolver {
   std::vector<double> m_lt, m_ls;
   std::vector<double> m_a, m_inv_piv, m_gamma, m_inv_eig;  // per (s, local k), k fastest
   std::vector<double> m_weights;
-  double m_sigma;
-  bool m_singular;
+  int m_zero_col = -1;  // the local column of a singular problem's zero mode (-1: none here)
   MPI_Comm m_comm;
   long m_transposes = 0;
   double m_transpose_seconds = 0, m_transpose_bytes = 0;
