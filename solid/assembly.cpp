@@ -199,7 +199,12 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
     }
   }
   m_force_scale = std::sqrt(scale2);
+  // Without the matrix the floor lacks |K| |u|: the last matrix assembly's floor stands in.
   m_roundoff_scale = std::sqrt(floor2);
+  if (with_matrix)
+    m_matrix_floor = m_roundoff_scale;
+  else
+    m_roundoff_scale = std::max(m_roundoff_scale, m_matrix_floor);
   return inverted;
 }
 

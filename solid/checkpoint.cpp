@@ -1,5 +1,6 @@
 // The solid's part of a checkpoint: the Newmark state of every body (u, v, M a, positions), the
-// contact slots with their active set and multipliers, the clock, and the run's counters.
+// contact slots with their active set and multipliers, the clock, the run's counters, and the
+// matrix values of the factor a step keeps (so a resumed run continues bit for bit).
 #include "checkpoint.hpp"
 
 #include "program.hpp"
@@ -49,6 +50,7 @@ void SolidProgram::save(fsi::H5File& h5) const {
   h5.write("solid/clock", std::vector<double>{s.time, s.contact_force_factor});
   h5.write("solid/counts", std::vector<std::int64_t>{s.step, m_steps, m_repeats, m_newton_total, m_newton_max});
   h5.write("solid/t_end", std::vector<double>{m_rt.settings().t_end});
+  h5.write("solid/kept_factor", m_solver->kept_factor());
 }
 
 void SolidProgram::load(const fsi::H5File& h5) {
@@ -73,6 +75,8 @@ void SolidProgram::load(const fsi::H5File& h5) {
   s.step = counts.at(0), m_steps = counts.at(1), m_repeats = counts.at(2);
   m_newton_total = counts.at(3), m_newton_max = counts.at(4);
   m_solver->restore_state(s);
+  m_solver->restore_kept_factor(h5.exists("solid/kept_factor") ? h5.read_doubles("solid/kept_factor")
+                                                                : std::vector<double>{});
 }
 
 }  // namespace solid

@@ -283,6 +283,7 @@ Config read_config(const fsi::SceneTable& s, double fluid_density) {
   st.newton_max_iterations = static_cast<int>(
       s.positive_integer("newton_max_iterations", defaults.newton_max_iterations));
   st.contact_tolerance = s.positive("contact_tolerance", defaults.contact_tolerance);
+  st.keep_factor = s.boolean("keep_factor", defaults.keep_factor);
   c.modes = static_cast<int>(s.integer("modes", 0));
   if (c.modes < 0) s.fail("modes", fmt::format("must be >= 0, got {}", c.modes));
   c.initial_mode = static_cast<int>(s.integer("initial_mode", 0));

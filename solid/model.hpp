@@ -99,6 +99,7 @@ struct Settings {
   double newton_tolerance = 1e-10;  // on ||R|| relative to the force scale
   int newton_max_iterations = 30;
   double contact_tolerance = 1e-10;  // on the gap, relative to the smallest element edge
+  bool keep_factor = true;  // a dynamic step may start with the last step's factor (newton.cpp)
 };
 
 struct Model {

@@ -27,6 +27,8 @@ void Solver::factorize_ahead(double dt) {
   // Active contact adds its curvature to iteration 0's matrix after assembly: no match to hope for.
   for (const auto& s : m_contact.slots())
     if (s.active) return;
+  // The step starts with the factor it holds (newton.cpp, kKeepRatio): nothing to do ahead.
+  if (m_keep_factor && m_factored_valid && m_contact.empty()) return;
   keep_step_start();  // as advance() begins (the residual's inertia reads them)
   assemble(newmark_c0(dt), dt, true, m_time + dt, nullptr);
   if (m_residual.allFinite()) factorize_cached();
@@ -58,15 +60,18 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
   m_iteration_velocity = m_model.settings.fluid_density > 0 ? iteration_velocity : nullptr;
   m_root_mass = root_mass;
   StepReport rep;
+  m_keep_allowed = m_model.settings.keep_factor;
   try {
     rep = newton(newmark_c0(dt), dt, t1, external, when);
   } catch (...) {
     m_iteration_velocity = nullptr;
     m_root_mass = nullptr;
+    m_keep_allowed = false;
     throw;
   }
   m_iteration_velocity = nullptr;
   m_root_mass = nullptr;
+  m_keep_allowed = false;
   // The next step's tangent (and its look-ahead factorisation) takes this step's root masses.
   m_root_mass_tangent = root_mass ? *root_mass : std::vector<std::vector<double>>{};
   update_velocity(dt);

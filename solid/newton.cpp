@@ -34,6 +34,12 @@ constexpr std::size_t kResidualsNamed = 5;
 // tangent then changes too little within the step to matter (a step of a body whose inertia
 // term 4M/dt^2 dominates its stiffness); a slower fall factorises the current tangent.
 constexpr double kReuseRatio = 1e-2;
+// A dynamic step starts with the factor the last step solved with (kept across steps) when that
+// step's first solve cut the residual by at least this factor: the matrix of a body whose
+// inertia 4M/dt^2 dominates its stiffness changes too little over a step to matter, and a kept
+// factor saves the look-ahead factorisation. At this contraction a step needs at most about
+// four solves (a residual 1e11 above its tolerance); a slower one factorises ahead again.
+constexpr double kKeepRatio = 1e-3;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -63,7 +69,15 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
   for (int it = 0;; ++it) {
     auto t0 = clock::now();
     m_tangent_root_mass_now = it > 0;  // add_root_mass: the first tangent takes the last step's
-    assemble_iterate(c0, dt, time_or_factor, external, it > 0, dx, when);
+    // The held factor serves this iteration (modified Newton) when it is valid, no contact can
+    // change the matrix's curvature, no prescribed increment needs the matrix in the residual,
+    // and either this is a later iteration (kept while it contracts fast, below) or a dynamic
+    // step's first iteration after a step whose first solve contracted by kKeepRatio. Such an
+    // iteration assembles the residual only; if the contraction then says "factorise", the
+    // matrix is assembled at the same iterate.
+    const bool may_reuse = m_factored_valid && m_contact.empty() && !m_dirichlet_pending &&
+                           (it > 0 || (m_keep_allowed && m_keep_factor));
+    assemble_iterate(c0, dt, time_or_factor, external, it > 0, dx, when, !may_reuse);
     rep.assembly_seconds += seconds_since(t0);
     const ContactLinearisation contact = linearise_contact(c0, dt, time_or_factor, external);
 
@@ -77,8 +91,13 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
       break;
     }
     if (it >= st.newton_max_iterations) break;
-    const bool reuse =
-        it > 0 && contact.candidates.empty() && rn <= kReuseRatio * previous && m_factored_valid;
+    const bool reuse = contact.candidates.empty() && m_factored_valid &&
+                       (it > 0 ? rn <= kReuseRatio * previous : may_reuse);
+    if (!reuse && may_reuse) {
+      t0 = clock::now();
+      assemble(c0, dt, true, time_or_factor, external);
+      rep.assembly_seconds += seconds_since(t0);
+    }
     previous = rn;
 
     t0 = clock::now();
@@ -94,6 +113,9 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
     apply_newton_step(dx);
     rep.iterations++;
   }
+  // The next dynamic step keeps this step's last factor if its first solve contracted enough.
+  const auto& r = rep.residuals;
+  if (m_keep_allowed && r.size() >= 2) m_keep_factor = r[1] <= kKeepRatio * r[0];
 
   m_tangent_root_mass_now = false;
   store_contact_forces();
@@ -140,8 +162,8 @@ void Solver::fail_contact_not_converged(const StepReport& rep, const std::string
 // x <- x - dx/2, x - 3 dx/4, ...; a residual still not finite stops the run.
 void Solver::assemble_iterate(double c0, double dt, double time_or_factor,
                               const std::vector<std::vector<double>>* external, bool have_step,
-                              Eigen::VectorXd& dx, const std::string& when) {
-  auto inverted = assemble(c0, dt, true, time_or_factor, external);
+                              Eigen::VectorXd& dx, const std::string& when, bool with_matrix) {
+  auto inverted = assemble(c0, dt, with_matrix, time_or_factor, external);
   for (int halving = 0; have_step && !m_residual.allFinite() && halving < kMaxStepHalvings;
        ++halving) {
     dx *= 0.5;
@@ -152,7 +174,7 @@ void Solver::assemble_iterate(double c0, double dt, double time_or_factor,
         if (B.eq[d] >= 0) B.u[d] -= dx[B.eq[d]];
       B.sync_positions();
     }
-    inverted = assemble(c0, dt, true, time_or_factor, external);
+    inverted = assemble(c0, dt, with_matrix, time_or_factor, external);
   }
   if (!m_residual.allFinite()) fail_non_finite_residual(inverted, when);
 }

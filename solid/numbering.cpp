@@ -189,9 +189,25 @@ bool Solver::factorize_cached() {
   }
   m_factored_valid = false;
   if (!m_linear.factorize(m_matrix)) return false;
+  ++m_factorizations;
   m_factored.assign(v, v + nnz);
   m_factored_valid = true;
   return true;
+}
+
+std::vector<double> Solver::kept_factor() const {
+  return m_keep_factor && m_factored_valid ? m_factored : std::vector<double>{};
+}
+
+void Solver::restore_kept_factor(const std::vector<double>& values) {
+  m_keep_factor = !values.empty();
+  if (values.empty()) return;
+  if (static_cast<std::size_t>(m_matrix.nonZeros()) != values.size())
+    fsi::fail("a checkpoint's kept factor has {} matrix values, the model's matrix {}",
+              values.size(), m_matrix.nonZeros());
+  std::copy(values.begin(), values.end(), m_matrix.valuePtr());
+  m_factored_valid = false;
+  if (!factorize_cached()) fsi::fail("a checkpoint's kept factor is singular");
 }
 
 void Solver::factorize(const std::string& when) {

@@ -306,6 +306,7 @@ nlohmann::json SolidProgram::report() const {
   j["newton_iterations_max"] = m_newton_max;
   j["phases"] = {{"assembly", m_assembly}, {"factorization", m_factor}, {"solve", m_solve}};
   j["factorizations_reused"] = s.factor_reuses();  // done ahead (begin) or unchanged matrix
+  j["factorizations"] = s.factorizations();  // done, ahead or in a step
   j["energy"] = {{"kinetic", s.kinetic_energy()},
                  {"strain", s.strain_energy()},
                  {"load_potential", s.load_potential()}};

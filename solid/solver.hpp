@@ -90,6 +90,11 @@ class Solver {
   // matrix is left for the step to report.
   void factorize_ahead(double dt);
   long factor_reuses() const { return m_factor_reuses; }
+  long factorizations() const { return m_factorizations; }
+  // Checkpoints: the values of the matrix whose factor the next step starts with, when it keeps
+  // one (empty otherwise); a resumed run factorises them again, so it continues bit for bit.
+  std::vector<double> kept_factor() const;
+  void restore_kept_factor(const std::vector<double>& values);
 
   // Coupled iterations: keep the current state / go back to a kept one (then advance() redoes
   // the step from it and gives bit for bit what it gave the first time with the same forces).
@@ -168,7 +173,7 @@ class Solver {
                     const std::vector<std::vector<double>>* external, const std::string& when);
   void assemble_iterate(double c0, double dt, double time_or_factor,
                         const std::vector<std::vector<double>>* external, bool have_step,
-                        Eigen::VectorXd& dx, const std::string& when);
+                        Eigen::VectorXd& dx, const std::string& when, bool with_matrix);
   bool is_converged(int it, double rn, double previous, double tolerance, double worst_gap,
                     double gap_tol) const;
   void apply_newton_step(const Eigen::VectorXd& dx);
@@ -209,6 +214,7 @@ class Solver {
   long m_step = 0;
   double m_force_scale = 0;              // norm of |F_ext| + |Q| + |inertia| from the last assembly
   double m_roundoff_scale = 0;           // the same with the terms of c0 M u: the round-off floor
+  double m_matrix_floor = 0;  // the floor's |K| |u| part is known from matrix assemblies only
   Eigen::SparseMatrix<double> m_matrix;  // lower triangle of K_eff on the free equations
   std::set<std::pair<int, int>> m_contact_entries;  // extra (row, col) entries contact needs
   Eigen::VectorXd m_residual;
@@ -216,6 +222,11 @@ class Solver {
   std::vector<double> m_factored;  // values of the matrix m_linear holds the factor of
   bool m_factored_valid = false;
   long m_factor_reuses = 0;
+  long m_factorizations = 0;
+  // A dynamic step may start with the factor the last one solved with (newton.cpp, kKeepRatio):
+  // allowed during advance(), earned by the last step's first contraction.
+  bool m_keep_allowed = false;
+  bool m_keep_factor = false;
   ContactSet m_contact;
   double m_contact_force_factor = 1;  // physical contact force / multiplier (1/2 in Newmark)
   bool m_dirichlet_pending = false;   // a prescribed increment awaits the first Newton solve

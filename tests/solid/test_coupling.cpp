@@ -221,7 +221,8 @@ TEST_CASE("coupled iterations: the linearised reaction vanishes at convergence a
 }
 
 // Work ahead of the forces: factorising the next step's first Newton matrix beforehand
-// (factorize_ahead) leaves every step bit for bit as it was, and each step reuses that factor;
+// (factorize_ahead) leaves every step bit for bit as it was, and each step reuses that factor
+// (with keep_factor, a step that keeps the last factor skips the look-ahead: still the same bits);
 // also with a prescribed displacement moving the right end (its increment enters the residual).
 TEST_CASE("factorising ahead: same steps, factor reused", "[coupling]") {
   for (bool prescribed : {false, true}) {
@@ -236,23 +237,83 @@ TEST_CASE("factorising ahead: same steps, factor reused", "[coupling]") {
       c.time.frequency = 2;
       m.bodies[0].constraints.push_back(c);
     }
-    Solver a(m), b(m);
-    const double dt = 2e-3;
-    const int steps = 12;
-    std::vector<std::vector<double>> f(2);
-    f[0].assign(a.positions(0).size(), 0.0);
-    for (int n = 0; n < steps; ++n) {
-      f[0][f[0].size() - 1] = 5.0 * std::sin(0.7 * n);  // a varying load on the last node
-      a.advance(dt, &f);
-      b.factorize_ahead(dt);
-      b.advance(dt, &f);
+    for (bool keep : {false, true}) {
+      m.settings.keep_factor = keep;
+      Solver a(m), b(m);
+      const double dt = 2e-3;
+      const int steps = 12;
+      std::vector<std::vector<double>> f(2);
+      f[0].assign(a.positions(0).size(), 0.0);
+      for (int n = 0; n < steps; ++n) {
+        f[0][f[0].size() - 1] = 5.0 * std::sin(0.7 * n);  // a varying load on the last node
+        a.advance(dt, &f);
+        b.factorize_ahead(dt);
+        b.advance(dt, &f);
+      }
+      CHECK(a.positions(0) == b.positions(0));
+      CHECK(a.velocities(0) == b.velocities(0));
+      if (!keep) CHECK(b.factor_reuses() - a.factor_reuses() == steps);
+      double moved = 0;  // the comparison is of a bar that moves
+      for (std::size_t d = 0; d < a.displacements(0).size(); ++d)
+        moved = std::max(moved, std::abs(a.displacements(0)[d]));
+      CHECK(moved > 1e-4);
     }
-    CHECK(a.positions(0) == b.positions(0));
-    CHECK(a.velocities(0) == b.velocities(0));
-    CHECK(b.factor_reuses() - a.factor_reuses() == steps);
-    double moved = 0;  // the comparison is of a bar that moves
-    for (std::size_t d = 0; d < a.displacements(0).size(); ++d)
-      moved = std::max(moved, std::abs(a.displacements(0)[d]));
-    CHECK(moved > 1e-4);
   }
+}
+
+// A factor kept across steps (keep_factor, newton.cpp's kKeepRatio) on a body whose inertia
+// dominates its stiffness: far fewer factorisations than steps, the same motion as a fresh
+// factor every step to the Newton tolerance; and a checkpoint's kept factor (kept_factor,
+// restore_kept_factor) continues the run bit for bit.
+TEST_CASE("a factor kept across steps: fewer factorisations, the same motion", "[coupling]") {
+  Model m = bar(0);
+  m.settings.newton_tolerance = 1e-12;
+  const double dt = 1e-5;
+  const int steps = 400;
+  auto load = [](int n, std::vector<std::vector<double>>& f) {
+    f[0][f[0].size() - 1] = 20.0 * std::sin(0.05 * n);  // a load on the last node
+  };
+  m.settings.keep_factor = false;
+  Solver fresh(m);
+  m.settings.keep_factor = true;
+  Solver kept(m), first_half(m);
+  std::vector<std::vector<double>> f(2);
+  f[0].assign(fresh.positions(0).size(), 0.0);
+  for (int n = 0; n < steps; ++n) {
+    load(n, f);
+    fresh.factorize_ahead(dt);
+    fresh.advance(dt, &f);
+    kept.factorize_ahead(dt);
+    kept.advance(dt, &f);
+    if (n < steps / 2) {
+      first_half.factorize_ahead(dt);
+      first_half.advance(dt, &f);
+    }
+  }
+  CHECK(fresh.factorizations() > steps / 2);
+  CHECK(kept.factorizations() < steps / 10);
+  INFO("factorisations " << fresh.factorizations() << " fresh, " << kept.factorizations() << " kept");
+  double moved = 0, diff = 0;
+  for (std::size_t d = 0; d < fresh.displacements(0).size(); ++d) {
+    moved = std::max(moved, std::abs(fresh.displacements(0)[d]));
+    diff = std::max(diff, std::abs(fresh.displacements(0)[d] - kept.displacements(0)[d]));
+  }
+  CHECK(moved > 1e-3);
+  INFO("moved " << moved << ", difference " << diff);
+  CHECK(diff <= 1e-10 * moved);
+  // Resume the second half from the first half's state and kept factor, in a new solver.
+  StepState s;
+  first_half.save_state(s);
+  const std::vector<double> factor = first_half.kept_factor();
+  CHECK_FALSE(factor.empty());
+  Solver resumed(m);
+  resumed.restore_state(s);
+  resumed.restore_kept_factor(factor);
+  for (int n = steps / 2; n < steps; ++n) {
+    load(n, f);
+    resumed.factorize_ahead(dt);
+    resumed.advance(dt, &f);
+  }
+  CHECK(resumed.positions(0) == kept.positions(0));
+  CHECK(resumed.velocities(0) == kept.velocities(0));
 }
