@@ -72,6 +72,11 @@ struct Config {
   AxisSpec x, y;
   std::array<SideBc, 4> bc;  // left, right, bottom, top
   bool implicit = false;     // Crank-Nicolson diffusion (else explicit AB2)
+  // Crank-Nicolson's immersed forcing: all of it after the solve ("after_solve", the default: the
+  // wall leaks into the body at large lambda), or on the explicit prediction before the solve and
+  // on the covered faces after it ("increment", predictor.cpp: the explicit scheme's wall at any
+  // lambda, but a moving body's coupling holds less: fluid/README.md).
+  bool forcing_in_increment = false;  // fluid.implicit_forcing, default "after_solve"
   // Weight of first-order upwind in the convective fluxes outside the sponge (0: central).
   double upwind_blend = 0;
   int ranks = 0;  // [fluid] ranks: the ranks ./fsi launches the fluid on (0: not given)

@@ -54,26 +54,11 @@ void Solver::predictor(double dt, double t_half) {
   }
 }
 
-// u~ += dt f_f / rho on the fibers' faces (the explicit predictor's last term). Crank-Nicolson:
-// the same term in its right-hand side B (predictor_implicit).
+// u~ += dt f_f / rho on the fibers' faces (the explicit predictor's last term; Crank-Nicolson:
+// on its explicit prediction u^, before the solve).
 void Solver::add_fiber_force(double dt, const CouplingIn& in) {
   const double ri = 1.0 / m_cfg.density;
-  const int nx = m_grid.nx(), ny = m_grid.ny();
-  if (m_cfg.implicit) {
-    const double scale = -1.0 / (0.5 * m_nu * dt);
-    for (int comp = 0; comp < 2; ++comp) {
-      const auto& idx = comp == 0 ? in.fiber_u_index : in.fiber_v_index;
-      const auto& frc = comp == 0 ? in.fiber_u_force : in.fiber_v_force;
-      const int ib = comp == 0 ? m_i0 : 0, jb = comp == 0 ? 0 : m_j0;
-      const int nt = solve_nt(comp);
-      for (std::size_t q = 0; q < idx.size(); ++q) {
-        const auto [i, j] = face_of(comp, idx[q]);
-        if (i < ib || i >= nx || j < jb || owned(j, comp) >= ny) continue;
-        m_rhs[comp][buf_index(i, j, ib, jb, nt)] += scale * dt * ri * frc[q];
-      }
-    }
-    return;
-  }
+  const int ny = m_grid.ny();
   for (std::size_t q = 0; q < in.fiber_u_index.size(); ++q) {
     const auto [i, j] = face_of(0, in.fiber_u_index[q]);
     if (i >= m_iu0 && i < m_iu1) m_u(i, owned(j, 0)) += dt * ri * in.fiber_u_force[q];
@@ -84,33 +69,44 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
   }
 }
 
-// Crank-Nicolson predictor, theta = nu dt / 2:
-//   (I - theta L) u~ = B,
-//   B  = u^n + dt [AB2(-div(u u)) - G p^n / rho + f / rho + f_f / rho] + theta L u^n
-//        + theta b^{n+1},
-// with b^{n+1} the boundary data at t^{n+1}. L is solved as the fast solver's L0, which equals L
-// except in the transform direction next to a wall or an outflow, where L0 uses the nearest
-// closure a real transform diagonalises (ghost -q0 or +q0). The difference is carried
-// explicitly with u^n, so a steady state is that of L exactly; this is stable for
-// nu dt / h_t^2 < 2 (checked by validate()).
+// Crank-Nicolson predictor in increment form, theta = nu dt / 2. The classical step
+//   (I - theta L0) u~ = u^n + dt R + theta L(u^n; b^n) + theta L(u^n; b^(n+1)) - theta L0 u^n,
+//   R = AB2(-div(u u)) - G p^n / rho + f / rho + f_f / rho,
+// (L0: the fast solver's operator, which differs from L only in the transform direction next to
+// a wall or an outflow, where it takes the nearest closure a real transform diagonalises, the
+// difference carried explicitly with u^n; stable for nu dt / h_t^2 < 2, checked by validate()) is,
+// with u~ = u^n + Y, the same as
+//   u^ = u^n + dt R + 2 theta L(u^n; b^n)                  (an explicit prediction)
+//   (I - theta L0) Y = u^ - u^n + theta [L(u^n; b^(n+1)) - L(u^n; b^n)].
+// The immersed solid's forcing (implicit_forcing = "increment", the default) acts on u^ before
+// the solve, u^_f = u^ + alpha (u_s - u^): the solve takes u^_f - u^n in place of u^ - u^n, and
+// u~ = u^n + Y. After the solve the faces the body covers (alpha = 1) are set to u_s
+// (immersed_forcing); a cut face keeps the solve's value. In a steady state with u^_f = u^n (the
+// explicit scheme's balance) Y = 0 and u~ = u^n: the wall sits where the explicit scheme puts it,
+// at any lambda = nu dt / h^2; and as u~ - u^n is always a solve's result, the explicit diffusion
+// in u^ never reaches u~ undamped (forcing a cut face after the solve as well would leave
+// alpha (1 - alpha) of it there, unstable from lambda of about 0.5). The reaction is what the
+// forcing put in: rho [alpha (u_s - u^) + (u_s - u~ on covered faces)] / dt. Without a body the
+// step is the classical one; "after_solve" forces u~ after the solve as the explicit scheme does
+// (the solve then acts on the unforced prediction inside the body, and the wall leaks).
 //
-// The immersed solid's forcing acts on the solve's result, as the explicit scheme forces its
-// predictor (immersed_forcing).
-//
-// This assembles B (scaled by -1/theta, as the Helmholtz solver takes it) in the solver's layout
-// into m_rhs, which add_fiber_force() completes and solve_implicit() solves.
+// This part runs before the coupling input: u^ into the fields' unknowns (the boundary faces and
+// ghosts hold t^(n+1)'s values), and the boundary increment theta [L(u^n; b^(n+1)) - L(u^n; b^n)]
+// (coefficient times the change of the value beyond the boundary row, from m_un, m_vn) into
+// m_rhs in the solver's layout. add_fiber_force() adds f_f to u^; solve_implicit() does the rest.
 void Solver::predictor_implicit(double dt, double t_half) {
   const double c1 = m_step == 0 ? 1.0 : 1.0 + 0.5 * dt / m_dt_prev;
   const double c0 = m_step == 0 ? 0.0 : -0.5 * dt / m_dt_prev;
   const auto acc = body_acceleration(t_half);
   const double ri = 1.0 / m_cfg.density;
-  const double theta = 0.5 * m_nu * dt, scale = -1.0 / theta;
+  const double theta = 0.5 * m_nu * dt;
   const int nx = m_grid.nx();
   const Axis& X = m_grid.x();
   const Axis& Y = m_grid.y();
 
   for (int comp = 0; comp < 2; ++comp) {
     Field& F = comp == 0 ? m_u : m_v;
+    const Field& Fn = comp == 0 ? m_un : m_vn;
     const Field& H = comp == 0 ? m_hu : m_hv;
     const Field& Ho = comp == 0 ? m_hu_old : m_hv_old;
     const Field& L = comp == 0 ? m_lu : m_lv;
@@ -119,10 +115,10 @@ void Solver::predictor_implicit(double dt, double t_half) {
     // Rows of the unknowns on this rank: [jr, row_hi()) (one rank: [jb, ny)).
     const int jr = std::max(jb, row_lo());
     std::vector<double>& buf = m_rhs[comp];
-    buf.resize(solve_size(comp));
+    buf.assign(solve_size(comp), 0.0);
     const double* gd = comp == 0 ? X.di() : Y.di();
     for (int j = jr; j < row_hi(); ++j) {
-      const double* f = F.row(j);
+      double* f = F.row(j);
       const double* h = H.row(j);
       const double* ho = Ho.row(j);
       const double* l = L.row(j);
@@ -130,14 +126,10 @@ void Solver::predictor_implicit(double dt, double t_half) {
       const double* pm = comp == 0 ? p - 1 : m_p.row(j - 1);  // p at the face's low side
       for (int i = ib; i < nx; ++i) {
         const double gp = (p[i] - pm[i]) * (comp == 0 ? gd[i] : gd[j]);
-        const double rhs =
-            f[i] + dt * (c1 * h[i] + c0 * ho[i] + acc[comp] - ri * gp) + theta * l[i];
-        const int k = buf_index(i, j, ib, jb, nt);
-        buf[k] = scale * rhs;
+        f[i] += dt * (c1 * h[i] + c0 * ho[i] + acc[comp] - ri * gp) + 2 * theta * l[i];
       }
     }
-    // Boundary rows: theta * coef * (value beyond the row at t^{n+1} - what the solved operator
-    // assumes there).
+    // Boundary rows: theta * coef * (the value beyond the row at t^(n+1) - at t^n).
     for (int s = 0; s < 4; ++s) {
       const SideBc& bc = m_bnd.side(s);
       if (bc.type == BcType::periodic) continue;
@@ -149,47 +141,67 @@ void Solver::predictor_implicit(double dt, double t_half) {
       // the columns (bottom, top).
       const bool here = a == 0 || (hi ? m_dec.has_top() : m_dec.has_bottom());
       const int kb = a == 0 ? jr : ib, ke = a == 0 ? row_hi() : here ? nx : ib;
-      auto val = [&](int nidx, int k) { return a == 0 ? F(nidx, k) : F(k, nidx); };
+      auto change = [&](int nidx, int k) {
+        return a == 0 ? F(nidx, k) - Fn(nidx, k) : F(k, nidx) - Fn(k, nidx);
+      };
       auto add = [&](int nidx, int k, double x) {
         const int i = a == 0 ? nidx : k, j = a == 0 ? k : nidx;
-        buf[buf_index(i, j, ib, jb, nt)] += scale * theta * x;
+        buf[buf_index(i, j, ib, jb, nt)] += theta * x;
       };
       if (a == comp) {  // normal component: boundary face value
         const int b = hi ? n : 0, f = hi ? n - 1 : 1;
         const double coef = hi ? ax.wi()[n - 1] * ax.di()[n - 1] : ax.wi()[0] * ax.di()[1];
-        for (int k = kb; k < ke; ++k) add(f, k, coef * val(b, k));
+        for (int k = kb; k < ke; ++k) add(f, k, coef * change(b, k));
       } else {  // tangential component: ghost value
-        const int g = hi ? n : -1, q0 = hi ? n - 1 : 0, q1 = hi ? n - 2 : 1;
+        const int g = hi ? n : -1, q0 = hi ? n - 1 : 0;
         const double coef = hi ? ax.di()[n] * ax.ci()[n - 1] : ax.di()[0] * ax.ci()[0];
-        const GhostRule& r = m_bnd.rule(s);
-        const bool in_transform = a == m_t_axis;
-        const double sgn = bc.type == BcType::slip ? 1.0 : -1.0;
-        for (int k = kb; k < ke; ++k) {
-          const double assumed = in_transform ? sgn * val(q0, k)
-                                 : r.is_data  ? 0.0
-                                              : r.ga * val(q0, k) + r.gb * val(q1, k);
-          add(q0, k, coef * (val(g, k) - assumed));
-        }
+        for (int k = kb; k < ke; ++k) add(q0, k, coef * change(g, k));
       }
     }
   }
 }
 
-// The Crank-Nicolson solve of the step: u~ = (I - theta L)^-1 B on the interior faces
-// (predictor_implicit); the immersed forcing follows on u~.
-void Solver::solve_implicit() {
-  const int nx = m_grid.nx();
+// The Crank-Nicolson solve of the step (predictor_implicit): the forcing alpha (u_s - u^) on u^
+// (kept in m_pull for the reaction), (I - theta L0) Y = u^_f - u^n + boundary increment,
+// u~ = u^n + Y. A coupled iteration's redo keeps u~ (solved with the first iteration's alpha and
+// u_s, the coupler's estimate of v^(n+1)) and sets the covered faces again: their reaction's
+// response to the iterated velocity is rho_f / dt, the one the solid linearises.
+void Solver::solve_implicit(const CouplingIn& in) {
+  const int nx = m_grid.nx(), ny = m_grid.ny();
+  const double scale = -1.0 / (0.5 * m_nu * m_begun_dt);  // the Helmholtz solver's B / -theta
   for (int comp = 0; comp < 2; ++comp) {
     Field& F = comp == 0 ? m_u : m_v;
+    const Field& Fn = comp == 0 ? m_un : m_vn;
     const int ib = comp == 0 ? m_i0 : 0, jb = comp == 0 ? 0 : m_j0;
     const int nt = solve_nt(comp);
     const std::vector<double>& rhs = m_rhs[comp];
     double* buf = solve_data(comp);
-    std::copy(rhs.begin(), rhs.end(), buf);
+    const int jr = std::max(jb, row_lo());
+    for (int j = jr; j < row_hi(); ++j) {
+      const double* f = F.row(j);
+      const double* fn = Fn.row(j);
+      for (int i = ib; i < nx; ++i) {
+        const int k = buf_index(i, j, ib, jb, nt);
+        buf[k] = scale * (f[i] - fn[i] + rhs[k]);
+      }
+    }
+    // The forcing on u^: alpha (u_s - u^), into the solve and kept to take off u~ after it.
+    const auto& idx = comp == 0 ? in.solid_u_index : in.solid_v_index;
+    const auto& alpha = comp == 0 ? in.solid_u_alpha : in.solid_v_alpha;
+    const auto& us = comp == 0 ? in.solid_u_velocity : in.solid_v_velocity;
+    std::vector<double>& pull = m_pull[comp];
+    pull.assign(idx.size(), 0.0);
+    for (std::size_t q = 0; q < idx.size() && m_cfg.forcing_in_increment; ++q) {
+      const auto [i, j] = face_of(comp, idx[q]);
+      if (i < ib || i >= nx || j < jb || owned(j, comp) >= ny) continue;
+      pull[q] = alpha[q] * (us[q] - F(i, j));
+      buf[buf_index(i, j, ib, jb, nt)] += scale * pull[q];
+    }
     solve(comp);
-    for (int j = std::max(jb, row_lo()); j < row_hi(); ++j) {
+    for (int j = jr; j < row_hi(); ++j) {
       double* f = F.row(j);
-      for (int i = ib; i < nx; ++i) f[i] = buf[buf_index(i, j, ib, jb, nt)];
+      const double* fn = Fn.row(j);
+      for (int i = ib; i < nx; ++i) f[i] = fn[i] + buf[buf_index(i, j, ib, jb, nt)];
     }
   }
 }

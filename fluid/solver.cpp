@@ -144,6 +144,8 @@ Solver::Solver(const Config& c, double dt, MPI_Comm comm)
   if (c.implicit) {
     m_lu = Field(nx + 1, ny, lo, hi);
     m_lv = Field(nx, ny + 1, lo, vhi);
+    m_un = Field(nx + 1, ny, lo, hi);
+    m_vn = Field(nx, ny + 1, lo, vhi);
     build_implicit(dt);
   }
   m_bnd.fill_ghosts(m_u, m_v);
@@ -263,6 +265,11 @@ void Solver::begin_step(double dt) {
     const PhaseTimer t(m_time.predictor);
     explicit_terms();
   }
+  if (m_cfg.implicit) {  // u^n with t^n's boundary values and ghosts (predictor_implicit)
+    const PhaseTimer t(m_time.predictor);
+    m_un = m_u;
+    m_vn = m_v;
+  }
   {
     const PhaseTimer t(m_time.boundaries);
     m_bnd.advance_normal(m_u, m_v, m_t + dt, dt);
@@ -281,14 +288,15 @@ void Solver::begin_step(double dt) {
 }
 
 // The step's second part: the fibers' force f_f into the predictor (Crank-Nicolson: then its
-// solve), u~ kept for a redo, then forcing, projection and samples.
+// solve, with the forcing on its explicit prediction), u~ kept for a redo, then forcing,
+// projection and samples.
 void Solver::end_step(double dt, const CouplingIn& in, CouplingOut& out) {
   if (m_phase != Phase::begun || m_begun_dt != dt)
     fsi::fail("fluid::Solver::end_step: no step of this dt begun");
   {
     const PhaseTimer t(m_time.predictor);
     add_fiber_force(dt, in);
-    if (m_cfg.implicit) solve_implicit();
+    if (m_cfg.implicit) solve_implicit(in);
     keep_predictor();
   }
   correct(dt, in, out);

@@ -145,7 +145,7 @@ class Solver {
   void predictor(double dt, double t_half);                                  // predictor.cpp
   void predictor_implicit(double dt, double t_half);                         // predictor.cpp
   void add_fiber_force(double dt, const CouplingIn& fibers);                 // predictor.cpp
-  void solve_implicit();                                                     // predictor.cpp
+  void solve_implicit(const CouplingIn& in);                                 // predictor.cpp
   void immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out);  // forcing.cpp
   // dt, and the time whose boundary pressures p^(n+1) takes (t^n + dt; t^n for project_initial).
   void project(double dt, double t_new);                                    // projection.cpp
@@ -204,9 +204,13 @@ class Solver {
   double m_begun_dt = 0;  // dt of the step begin_step() began
   std::unique_ptr<FastSolver> m_poisson, m_helm_u, m_helm_v;
   std::unique_ptr<SlabSolver> m_slab_poisson, m_slab_u, m_slab_v;  // on several ranks
-  // Crank-Nicolson: the step's right-hand side B (scaled), per component, in the Helmholtz
+  // Crank-Nicolson: the boundary increment of the step's solve, per component, in the Helmholtz
   // solver's layout (predictor_implicit), until its solve.
   std::array<std::vector<double>, 2> m_rhs;
+  // Crank-Nicolson: u^n (with t^n's boundary values and ghosts) during the step, and the forcing
+  // alpha (u_s - u^) per solid face of the coupling input (solve_implicit).
+  Field m_un, m_vn;
+  std::array<std::vector<double>, 2> m_pull;
   Timings m_time;
 };
 
