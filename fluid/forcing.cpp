@@ -19,39 +19,33 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
   out.solid_u_force.resize(in.solid_u_index.size());
   out.solid_v_force.resize(in.solid_v_index.size());
   const bool cn = m_cfg.implicit && m_cfg.forcing_in_increment;
+  // The force on one face, whose velocity is w (alpha a, body velocity ws, pull of the
+  // increment's forcing).
+  auto force = [&](double& w, double a, double ws, double pull) {
+    if (!cn) {
+      const double f = rho * a * (ws - w) / dt;
+      w += dt * f / rho;
+      return f;
+    }
+    const double post = a >= kCovered ? ws - w : 0.0;
+    w += post;
+    return rho * (pull + post) / dt;
+  };
   for (std::size_t q = 0; q < in.solid_u_index.size(); ++q) {
     const auto [i, j] = face_of(0, in.solid_u_index[q]);
-    double f = 0;
-    if (i >= m_iu0 && i < m_iu1) {
-      double& u = m_u(i, owned(j, 0));
-      const double a = in.solid_u_alpha[q], us = in.solid_u_velocity[q];
-      if (cn) {
-        const double post = a >= kCovered ? us - u : 0.0;
-        u += post;
-        f = rho * (m_pull[0][q] + post) / dt;
-      } else {
-        f = rho * a * (us - u) / dt;
-        u += dt * f / rho;
-      }
-    }
-    out.solid_u_force[q] = f;
+    out.solid_u_force[q] =
+        i >= m_iu0 && i < m_iu1
+            ? force(m_u(i, owned(j, 0)), in.solid_u_alpha[q], in.solid_u_velocity[q],
+                    cn ? m_pull[0][q] : 0.0)
+            : 0.0;
   }
   for (std::size_t q = 0; q < in.solid_v_index.size(); ++q) {
     const auto [i, j] = face_of(1, in.solid_v_index[q]);
-    double f = 0;
-    if (j >= m_j0 && owned(j, 1) < ny) {
-      double& v = m_v(i, j);
-      const double a = in.solid_v_alpha[q], vs = in.solid_v_velocity[q];
-      if (cn) {
-        const double post = a >= kCovered ? vs - v : 0.0;
-        v += post;
-        f = rho * (m_pull[1][q] + post) / dt;
-      } else {
-        f = rho * a * (vs - v) / dt;
-        v += dt * f / rho;
-      }
-    }
-    out.solid_v_force[q] = f;
+    out.solid_v_force[q] =
+        j >= m_j0 && owned(j, 1) < ny
+            ? force(m_v(i, j), in.solid_v_alpha[q], in.solid_v_velocity[q],
+                    cn ? m_pull[1][q] : 0.0)
+            : 0.0;
   }
 }
 
