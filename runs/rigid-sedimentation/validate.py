@@ -7,6 +7,9 @@ of a cylinder between two plane walls (README.md).
                       same nu dt / h^2 = 1.02), rho_s/rho_f = 3 explicit and 1.5 with coupled
                       iterations, to t = 1.5
   validate --short    h = 1/32 only, both density ratios, to t = 1
+  validate --increment [--short]
+                      the default grids and time steps with Crank-Nicolson's forcing in its
+                      increment ([fluid] implicit_forcing = "increment"); summary-increment.json
   validate --explicit-diffusion [--short]
                       the same grids with explicit diffusion at nu dt / h^2 = 0.1 (dt = 0.1 h^2),
                       rho_s/rho_f = 3 only; its summary goes to summary-explicit-diffusion.json
@@ -26,9 +29,12 @@ import outputs  # noqa: E402
 PARSER = cli.parser(__doc__)
 PARSER.add_argument("--explicit-diffusion", action="store_true",
                     help="explicit diffusion at nu dt / h^2 = 0.1, rho_s/rho_f = 3 only")
+PARSER.add_argument("--increment", action="store_true",
+                    help='Crank-Nicolson with [fluid] implicit_forcing = "increment"')
 ARGS = PARSER.parse_args()
 SHORT = ARGS.short
 EXPLICIT = ARGS.explicit_diffusion
+INCREMENT = ARGS.increment
 HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = job.out_dir("rigid-sedimentation")
 
@@ -77,6 +83,9 @@ def scene(n, ratio, iterate):
         text = text.replace("dt = 1e-3", f"dt = {0.1 / (MU * n * n):.10g}")
     else:
         text = text.replace("dt = 1e-3", f"dt = {1e-3 * (32 / n) ** 2:g}")
+        if INCREMENT:
+            text = text.replace('diffusion = "implicit"',
+                                'diffusion = "implicit"\nimplicit_forcing = "increment"')
     return text + (ITERATIONS if iterate else "")
 
 
@@ -84,7 +93,7 @@ def main():
     rows, metrics = [], {}
     for n in GRIDS:
         for ratio, iterate in RATIOS:
-            name = (("diffusion-explicit-" if EXPLICIT else "")
+            name = (("diffusion-explicit-" if EXPLICIT else "increment-" if INCREMENT else "")
                     + f"h{n}-ratio-{ratio:g}-{'iter' if iterate else 'explicit'}")
             r = job.run(name, scene(n, ratio, iterate), check=False)
             row = {"cells_per_length": n, "ratio": ratio, "iterations": iterate,
@@ -124,7 +133,8 @@ def main():
                                     f"{row['iterations_max']})" if iterate else "")
                                  if row["completed"] else f"stopped: {row['message']}"), flush=True)
     finish("rigid-sedimentation", metrics, {"runs": rows}, short=SHORT,
-           name="summary-explicit-diffusion.json" if EXPLICIT else "summary.json")
+           name="summary-explicit-diffusion.json" if EXPLICIT
+           else "summary-increment.json" if INCREMENT else "summary.json")
 
 
 if __name__ == "__main__":
