@@ -283,9 +283,15 @@ Config read_config(const fsi::SceneTable& f, double dt) {
   c.density = f.positive("density");
   c.viscosity = f.positive("viscosity");
   c.implicit = f.choice("diffusion", {"explicit", "implicit"}, "explicit") == "implicit";
-  if (f.has("implicit_forcing"))
+  if (f.has("implicit_forcing")) {
     c.forcing_in_increment =
         f.choice("implicit_forcing", {"after_solve", "increment"}, "after_solve") == "increment";
+    if (!c.implicit)
+      f.fail("implicit_forcing",
+             fmt::format("= \"{}\" applies to Crank-Nicolson only: set diffusion = \"implicit\" "
+                         "or remove the key",
+                         c.forcing_in_increment ? "increment" : "after_solve"));
+  }
   // Only when given: a scene without it keeps its effective scene as it was.
   if (f.has("upwind_blend")) c.upwind_blend = f.in_range("upwind_blend", 0.0, 1.0, false, 0.0);
   // The launcher's: how many ranks ./fsi gives the fluid (the job's own count decides).

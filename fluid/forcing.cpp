@@ -19,6 +19,11 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
   out.solid_u_force.resize(in.solid_u_index.size());
   out.solid_v_force.resize(in.solid_v_index.size());
   const bool cn = m_cfg.implicit && m_cfg.forcing_in_increment;
+  if (cn && (m_pull[0].size() != in.solid_u_index.size() ||
+             m_pull[1].size() != in.solid_v_index.size()))
+    fsi::fail("protocol error: the step's solid faces changed between its solve and its forcing "
+              "({} and {} u, v faces against {} and {})", m_pull[0].size(), m_pull[1].size(),
+              in.solid_u_index.size(), in.solid_v_index.size());
   // The force on one face, whose velocity is w (alpha a, body velocity ws, pull of the
   // increment's forcing).
   auto force = [&](double& w, double a, double ws, double pull) {

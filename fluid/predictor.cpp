@@ -78,7 +78,7 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
 // with u~ = u^n + Y, the same as
 //   u^ = u^n + dt R + 2 theta L(u^n; b^n)                  (an explicit prediction)
 //   (I - theta L0) Y = u^ - u^n + theta [L(u^n; b^(n+1)) - L(u^n; b^n)].
-// The immersed solid's forcing (implicit_forcing = "increment", the default) acts on u^ before
+// The immersed solid's forcing with implicit_forcing = "increment" acts on u^ before
 // the solve, u^_f = u^ + alpha (u_s - u^): the solve takes u^_f - u^n in place of u^ - u^n, and
 // u~ = u^n + Y. After the solve the faces the body covers (alpha = 1) are set to u_s
 // (immersed_forcing); a cut face keeps the solve's value. In a steady state with u^_f = u^n (the

@@ -36,7 +36,10 @@ void Solver::add_scene_loads(const Body& B, double t, std::vector<double>& f) co
 std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, double time_or_factor,
                                      const std::vector<std::vector<double>>* external) {
   std::pair<int, int> inverted{-1, -1};
-  if (with_matrix) std::fill_n(m_matrix.valuePtr(), m_matrix.nonZeros(), 0.0);
+  if (with_matrix) {
+    std::fill_n(m_matrix.valuePtr(), m_matrix.nonZeros(), 0.0);
+    m_matrix_c0 = c0;
+  }
   m_residual.setZero();
   double scale2 = 0, floor2 = 0;
   double* values = m_matrix.valuePtr();

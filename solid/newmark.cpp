@@ -28,7 +28,8 @@ void Solver::factorize_ahead(double dt) {
   for (const auto& s : m_contact.slots())
     if (s.active) return;
   // The step starts with the factor it holds (newton.cpp, kKeepRatio): nothing to do ahead.
-  if (m_keep_factor && m_factored_valid && m_contact.empty()) return;
+  if (m_keep_factor && m_factored_valid && m_contact.empty() && m_factored_c0 == newmark_c0(dt))
+    return;
   keep_step_start();  // as advance() begins (the residual's inertia reads them)
   assemble(newmark_c0(dt), dt, true, m_time + dt, nullptr);
   if (m_residual.allFinite()) factorize_cached();
@@ -60,7 +61,8 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
   m_iteration_velocity = m_model.settings.fluid_density > 0 ? iteration_velocity : nullptr;
   m_root_mass = root_mass;
   StepReport rep;
-  m_keep_allowed = m_model.settings.keep_factor;
+  m_keep_allowed = m_model.settings.keep_factor && m_keep_permitted;
+  if (!m_keep_allowed) m_keep_factor = false;
   try {
     rep = newton(newmark_c0(dt), dt, t1, external, when);
   } catch (...) {

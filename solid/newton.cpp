@@ -65,6 +65,7 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
   Eigen::VectorXd dx(m_neq);
   double previous = std::numeric_limits<double>::infinity();
   bool contact_active_or_open = false;  // the last iteration had contact candidates
+  const bool had_increment = m_dirichlet_pending;
 
   for (int it = 0;; ++it) {
     auto t0 = clock::now();
@@ -75,8 +76,9 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
     // step's first iteration after a step whose first solve contracted by kKeepRatio. Such an
     // iteration assembles the residual only; if the contraction then says "factorise", the
     // matrix is assembled at the same iterate.
-    const bool may_reuse = m_factored_valid && m_contact.empty() && !m_dirichlet_pending &&
-                           (it > 0 || (m_keep_allowed && m_keep_factor));
+    const bool may_reuse =
+        m_factored_valid && m_contact.empty() && !m_dirichlet_pending &&
+        (it > 0 || (m_keep_allowed && m_keep_factor && m_factored_c0 == c0));
     assemble_iterate(c0, dt, time_or_factor, external, it > 0, dx, when, !may_reuse);
     rep.assembly_seconds += seconds_since(t0);
     const ContactLinearisation contact = linearise_contact(c0, dt, time_or_factor, external);
@@ -113,9 +115,12 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
     apply_newton_step(dx);
     rep.iterations++;
   }
-  // The next dynamic step keeps this step's last factor if its first solve contracted enough.
+  // The next dynamic step keeps this step's last factor if its first solve contracted enough;
+  // not after a step with a prescribed increment (the next one has one too, and its first matrix
+  // is the look-ahead's to factorise), nor with contact (whose entries grow the pattern).
   const auto& r = rep.residuals;
-  if (m_keep_allowed && r.size() >= 2) m_keep_factor = r[1] <= kKeepRatio * r[0];
+  if (m_keep_allowed && r.size() >= 2)
+    m_keep_factor = r[1] <= kKeepRatio * r[0] && !had_increment && m_contact.empty();
 
   m_tangent_root_mass_now = false;
   store_contact_forces();

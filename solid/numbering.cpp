@@ -191,23 +191,29 @@ bool Solver::factorize_cached() {
   if (!m_linear.factorize(m_matrix)) return false;
   ++m_factorizations;
   m_factored.assign(v, v + nnz);
+  m_factored_c0 = m_matrix_c0;
   m_factored_valid = true;
   return true;
 }
 
-std::vector<double> Solver::kept_factor() const {
-  return m_keep_factor && m_factored_valid ? m_factored : std::vector<double>{};
+KeptFactor Solver::kept_factor() const {
+  if (!(m_keep_factor && m_factored_valid && m_contact.empty())) return {};
+  return {m_factored, m_factored_c0, m_matrix_floor};
 }
 
-void Solver::restore_kept_factor(const std::vector<double>& values) {
-  m_keep_factor = !values.empty();
-  if (values.empty()) return;
-  if (static_cast<std::size_t>(m_matrix.nonZeros()) != values.size())
-    fsi::fail("a checkpoint's kept factor has {} matrix values, the model's matrix {}",
-              values.size(), m_matrix.nonZeros());
-  std::copy(values.begin(), values.end(), m_matrix.valuePtr());
+void Solver::restore_kept_factor(const KeptFactor& k) {
+  m_keep_factor = false;
+  m_matrix_floor = k.matrix_floor;
+  // A checkpoint of another pattern (contact entries) or a run resumed without keeping starts
+  // with the look-ahead as usual.
+  if (k.values.empty() || !m_model.settings.keep_factor || !m_contact.empty() ||
+      static_cast<std::size_t>(m_matrix.nonZeros()) != k.values.size())
+    return;
+  std::copy(k.values.begin(), k.values.end(), m_matrix.valuePtr());
+  m_matrix_c0 = k.c0;
   m_factored_valid = false;
   if (!factorize_cached()) fsi::fail("a checkpoint's kept factor is singular");
+  m_keep_factor = true;
 }
 
 void Solver::factorize(const std::string& when) {

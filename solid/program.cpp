@@ -191,6 +191,7 @@ void SolidProgram::advance(const fsi::proto::StepBegin& sb, const fsi::proto::So
       const auto& s = m_rt.settings();
       m_last = m_solver->solve_static_step(std::min(1.0, (sb.time + sb.dt) / s.t_end));
     } else {
+      m_solver->allow_kept_factor(sb.may_repeat == 0);
       m_last = m_solver->advance(sb.dt, &m_external, in.velocity.empty() ? nullptr : &in.velocity,
                                  in.root_mass.empty() ? nullptr : &in.root_mass);
     }

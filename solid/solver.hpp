@@ -50,6 +50,14 @@ struct StepState {
   double contact_force_factor = 1;
 };
 
+// The factor a dynamic step keeps for the next (checkpoints): the matrix values it was computed
+// from, their inertia factor c0 = 4/dt^2 and the round-off floor's matrix part at that time.
+struct KeptFactor {
+  std::vector<double> values;  // empty: none kept
+  double c0 = 0;
+  double matrix_floor = 0;
+};
+
 class Solver {
  public:
   // Validates the model (throws fsi::InputError for bad input), numbers the equations, builds
@@ -93,8 +101,11 @@ class Solver {
   long factorizations() const { return m_factorizations; }
   // Checkpoints: the values of the matrix whose factor the next step starts with, when it keeps
   // one (empty otherwise); a resumed run factorises them again, so it continues bit for bit.
-  std::vector<double> kept_factor() const;
-  void restore_kept_factor(const std::vector<double>& values);
+  KeptFactor kept_factor() const;
+  void restore_kept_factor(const KeptFactor& k);
+  // A step that the coupler may repeat (coupled iterations) starts from a fresh factor, so that a
+  // repeat with the same forces gives the same bits (the kept factor is not part of StepState).
+  void allow_kept_factor(bool allow) { m_keep_permitted = allow; }
 
   // Coupled iterations: keep the current state / go back to a kept one (then advance() redoes
   // the step from it and gives bit for bit what it gave the first time with the same forces).
@@ -227,6 +238,9 @@ class Solver {
   // allowed during advance(), earned by the last step's first contraction.
   bool m_keep_allowed = false;
   bool m_keep_factor = false;
+  bool m_keep_permitted = true;  // allow_kept_factor
+  double m_matrix_c0 = 0;        // the inertia factor 4/dt^2 of the last matrix assembled
+  double m_factored_c0 = 0;      // ... and of the matrix factorised
   ContactSet m_contact;
   double m_contact_force_factor = 1;  // physical contact force / multiplier (1/2 in Newmark)
   bool m_dirichlet_pending = false;   // a prescribed increment awaits the first Newton solve

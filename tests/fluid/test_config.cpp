@@ -109,6 +109,21 @@ TEST_CASE("upwind_blend: read, and refused outside [0, 1]", "[fluid][config][upw
                     Contains("upwind_blend") && Contains("1.5"));
 }
 
+TEST_CASE("implicit_forcing: read with Crank-Nicolson, refused without it or unknown",
+          "[fluid][config][implicit]") {
+  const std::string cn = replace(kGood, "viscosity = 0.01", "viscosity = 0.01\ndiffusion = \"implicit\"");
+  CHECK_FALSE(read(cn).forcing_in_increment);  // "after_solve" by default
+  CHECK(read(replace(cn, "viscosity = 0.01", "viscosity = 0.01\nimplicit_forcing = \"increment\""))
+            .forcing_in_increment);
+  CHECK_THROWS_WITH(
+      read(replace(cn, "viscosity = 0.01", "viscosity = 0.01\nimplicit_forcing = \"inside\"")),
+      Contains("implicit_forcing") && Contains("inside"));
+  CHECK_THROWS_WITH(read(replace(kGood, "viscosity = 0.01",
+                                 "viscosity = 0.01\nimplicit_forcing = \"increment\"")),
+                    Contains("implicit_forcing") && Contains("increment") &&
+                        Contains("Crank-Nicolson only"));
+}
+
 TEST_CASE("pressure boundaries: where they are allowed", "[fluid][config][pressure]") {
   std::string open = replace(kGood, "left = { type = \"periodic\" }",
                              "left = { type = \"pressure\", value = 2.0, ramp = \"cosine\", ramp_time = 0.5 }");

@@ -38,8 +38,8 @@ struct BlockInput {
   }
 };
 
-// The diffusion options: explicit AB2, Crank-Nicolson with the forcing in its increment (the
-// default) or after its solve.
+// The diffusion options: explicit AB2, Crank-Nicolson with the forcing in its increment or after
+// its solve (the default).
 enum Diffusion { explicit_ab2, crank_nicolson, crank_nicolson_after_solve };
 constexpr Diffusion kDiffusions[] = {explicit_ab2, crank_nicolson, crank_nicolson_after_solve};
 Config with(Config c, Diffusion d) {
