@@ -2,6 +2,8 @@
 // use.
 #include "summary.hpp"
 
+#include <ctime>
+
 #include <unistd.h>
 
 #include <cmath>
@@ -65,11 +67,21 @@ PhaseTimer::Id PhaseTimer::phase(std::string_view name) {
   return m_entries.size() - 1;
 }
 
+namespace {
+// CPU seconds of the calling thread.
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+}  // namespace
+
 void PhaseTimer::start(Id id) {
   Entry& e = m_entries.at(id);
   if (e.is_running) fail("phase timer: '{}' started twice", e.name);
   e.is_running = true;
   e.started = Clock::now();
+  e.cpu_started = thread_cpu_seconds();
 }
 
 void PhaseTimer::stop(Id id) {
@@ -78,6 +90,7 @@ void PhaseTimer::stop(Id id) {
   if (!e.is_running) fail("phase timer: '{}' stopped but not running", e.name);
   e.is_running = false;
   e.seconds += std::chrono::duration<double>(now - e.started).count();
+  e.cpu_seconds += thread_cpu_seconds() - e.cpu_started;
   ++e.calls;
 }
 
@@ -114,7 +127,9 @@ nlohmann::ordered_json PhaseTimer::to_json() const {
   for (const Entry& e : m_entries)
     j[e.name] = {{"seconds", e.seconds},
                  {"calls", e.calls},
-                 {"seconds_per_call", e.calls > 0 ? e.seconds / double(e.calls) : 0.0}};
+                 {"seconds_per_call", e.calls > 0 ? e.seconds / double(e.calls) : 0.0},
+                 {"cpu_seconds", e.cpu_seconds},
+                 {"cpu_seconds_per_call", e.calls > 0 ? e.cpu_seconds / double(e.calls) : 0.0}};
   return j;
 }
 

@@ -93,16 +93,20 @@ class PhaseTimer {
   double total_seconds() const;  // sum over phases (phases are meant not to overlap)
   std::vector<std::string> names() const;
 
-  // {"predictor": {"seconds": s, "calls": n, "seconds_per_call": s/n}, ...} in registration order
-  // (nlohmann::ordered_json keeps it).
+  // {"predictor": {"seconds": s, "calls": n, "seconds_per_call": s/n, "cpu_seconds": c,
+  // "cpu_seconds_per_call": c/n}, ...} in registration order (nlohmann::ordered_json keeps it).
+  // The CPU time is that of the thread that times the phase (not of helper threads): its own
+  // work, without the time it was descheduled while the phase ran.
   nlohmann::ordered_json to_json() const;
 
  private:
   struct Entry {
     std::string name;
     double seconds = 0.0;
+    double cpu_seconds = 0.0;  // of the thread that starts and stops the phase
     long calls = 0;
     Clock::time_point started{};
+    double cpu_started = 0.0;
     bool is_running = false;
   };
   const Entry* find(std::string_view name) const;

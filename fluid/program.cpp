@@ -301,6 +301,7 @@ nlohmann::json FluidProgram::report() const {
                  {"boundaries", tm.boundaries},
                  {"poisson", tm.poisson},
                  {"projection", tm.projection}};
+  j["phases_cpu_seconds"] = tm.cpu;  // the phases' CPU time, without descheduled time
   j["ns_per_cell_step"] = 1e9 * total / (cells * steps);
   // On several ranks: this rank's rows and what its exchanges cost (inside the phases above).
   const Decomposition& d = m_solver->decomposition();

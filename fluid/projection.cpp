@@ -58,10 +58,10 @@ void Solver::project(double dt, double t_new) {
     }
   }
   {
-    const PhaseTimer t(m_time.poisson);
+    const PhaseTimer t(m_time.poisson, m_time.cpu);
     solve(2);
   }
-  const PhaseTimer t(m_time.projection);
+  const PhaseTimer t(m_time.projection, m_time.cpu);
   for (int j = lo; j < hi; ++j) {
     double* phi = m_phi.row(j);
     double* p = m_p.row(j);

@@ -262,20 +262,20 @@ void Solver::begin_step(double dt) {
   if (m_phase == Phase::begun)
     fsi::fail("fluid::Solver: a step was begun (begin_step) and not ended");
   {
-    const PhaseTimer t(m_time.predictor);
+    const PhaseTimer t(m_time.predictor, m_time.cpu);
     explicit_terms();
   }
   if (m_cfg.implicit) {  // u^n with t^n's boundary values and ghosts (predictor_implicit)
-    const PhaseTimer t(m_time.predictor);
+    const PhaseTimer t(m_time.predictor, m_time.cpu);
     m_un = m_u;
     m_vn = m_v;
   }
   {
-    const PhaseTimer t(m_time.boundaries);
+    const PhaseTimer t(m_time.boundaries, m_time.cpu);
     m_bnd.advance_normal(m_u, m_v, m_t + dt, dt);
     if (m_cfg.implicit) m_bnd.fill_ghosts(m_u, m_v);  // Crank-Nicolson: ghosts of the new wall data
   }
-  const PhaseTimer t(m_time.predictor);
+  const PhaseTimer t(m_time.predictor, m_time.cpu);
   if (m_step == 0) m_dt_prev = dt;
   if (m_cfg.implicit) {
     if (dt != m_dt_implicit) build_implicit(dt);
@@ -294,7 +294,7 @@ void Solver::end_step(double dt, const CouplingIn& in, CouplingOut& out) {
   if (m_phase != Phase::begun || m_begun_dt != dt)
     fsi::fail("fluid::Solver::end_step: no step of this dt begun");
   {
-    const PhaseTimer t(m_time.predictor);
+    const PhaseTimer t(m_time.predictor, m_time.cpu);
     add_fiber_force(dt, in);
     if (m_cfg.implicit) solve_implicit(in);
     keep_predictor();
@@ -339,12 +339,12 @@ void Solver::restore_predictor() {
 // t^n -> t^(n+1) (the explicit terms H^n become H^(n-1)).
 void Solver::correct(double dt, const CouplingIn& in, CouplingOut& out) {
   {
-    const PhaseTimer t(m_time.predictor);
+    const PhaseTimer t(m_time.predictor, m_time.cpu);
     immersed_forcing(dt, in, out);
   }
   project(dt, m_t + dt);
   {
-    const PhaseTimer t(m_time.boundaries);
+    const PhaseTimer t(m_time.boundaries, m_time.cpu);
     m_bnd.fill_ghosts(m_u, m_v);
     sample(in, out);
   }

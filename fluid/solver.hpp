@@ -58,6 +58,7 @@ struct CouplingOut {
 // Seconds spent per phase, accumulated over steps.
 struct Timings {
   double predictor = 0, boundaries = 0, poisson = 0, projection = 0;
+  double cpu = 0;  // CPU time of the phases above (the solver's thread), all together
   long steps = 0;
   long repeats = 0;  // steps redone (coupled iterations), not in `steps`
 };
