@@ -67,14 +67,11 @@ PhaseTimer::Id PhaseTimer::phase(std::string_view name) {
   return m_entries.size() - 1;
 }
 
-namespace {
-// CPU seconds of the calling thread.
 double thread_cpu_seconds() {
   timespec t{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
   return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
-}  // namespace
 
 void PhaseTimer::start(Id id) {
   Entry& e = m_entries.at(id);

@@ -18,6 +18,9 @@
 
 namespace fsi {
 
+// CPU seconds of the calling thread (phase timers: a phase's own work).
+double thread_cpu_seconds();
+
 // Write `text` to `path` through a temporary file in the same folder and a rename, so that the
 // file is at every moment either the old or the new content. Throws fsi::Error naming the path.
 void write_file_atomically(const std::filesystem::path& path, std::string_view text);

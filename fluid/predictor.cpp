@@ -185,17 +185,20 @@ void Solver::solve_implicit(const CouplingIn& in) {
         buf[k] = scale * (f[i] - fn[i] + rhs[k]);
       }
     }
-    // The forcing on u^: alpha (u_s - u^), into the solve and kept to take off u~ after it.
-    const auto& idx = comp == 0 ? in.solid_u_index : in.solid_v_index;
-    const auto& alpha = comp == 0 ? in.solid_u_alpha : in.solid_v_alpha;
-    const auto& us = comp == 0 ? in.solid_u_velocity : in.solid_v_velocity;
-    std::vector<double>& pull = m_pull[comp];
-    pull.assign(idx.size(), 0.0);
-    for (std::size_t q = 0; q < idx.size() && m_cfg.forcing_in_increment; ++q) {
-      const auto [i, j] = face_of(comp, idx[q]);
-      if (i < ib || i >= nx || j < jb || owned(j, comp) >= ny) continue;
-      pull[q] = alpha[q] * (us[q] - F(i, j));
-      buf[buf_index(i, j, ib, jb, nt)] += scale * pull[q];
+    // implicit_forcing = "increment": the forcing on u^, alpha (u_s - u^), into the solve and
+    // kept for the reaction (immersed_forcing).
+    if (m_cfg.forcing_in_increment) {
+      const auto& idx = comp == 0 ? in.solid_u_index : in.solid_v_index;
+      const auto& alpha = comp == 0 ? in.solid_u_alpha : in.solid_v_alpha;
+      const auto& us = comp == 0 ? in.solid_u_velocity : in.solid_v_velocity;
+      std::vector<double>& pull = m_pull[comp];
+      pull.assign(idx.size(), 0.0);
+      for (std::size_t q = 0; q < idx.size(); ++q) {
+        const auto [i, j] = face_of(comp, idx[q]);
+        if (i < ib || i >= nx || j < jb || owned(j, comp) >= ny) continue;
+        pull[q] = alpha[q] * (us[q] - F(i, j));
+        buf[buf_index(i, j, ib, jb, nt)] += scale * pull[q];
+      }
     }
     solve(comp);
     for (int j = jr; j < row_hi(); ++j) {

@@ -288,8 +288,8 @@ void Solver::begin_step(double dt) {
 }
 
 // The step's second part: the fibers' force f_f into the predictor (Crank-Nicolson: then its
-// solve, with the forcing on its explicit prediction), u~ kept for a redo, then forcing,
-// projection and samples.
+// solve, with implicit_forcing = "increment" the forcing on its explicit prediction), u~ kept for
+// a redo, then forcing, projection and samples.
 void Solver::end_step(double dt, const CouplingIn& in, CouplingOut& out) {
   if (m_phase != Phase::begun || m_begun_dt != dt)
     fsi::fail("fluid::Solver::end_step: no step of this dt begun");
