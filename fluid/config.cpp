@@ -292,6 +292,9 @@ Config read_config(const fsi::SceneTable& f, double dt) {
                          "or remove the key",
                          c.forcing_in_increment ? "increment" : "after_solve"));
   }
+  if (f.has("body_viscosity"))
+    c.bodies_inviscid =
+        f.choice("body_viscosity", {"kelvin-voigt", "none"}, "kelvin-voigt") == "none";
   // Only when given: a scene without it keeps its effective scene as it was.
   if (f.has("upwind_blend")) c.upwind_blend = f.in_range("upwind_blend", 0.0, 1.0, false, 0.0);
   // The launcher's: how many ranks ./fsi gives the fluid (the job's own count decides).

@@ -77,6 +77,10 @@ struct Config {
   // on the covered faces after it ("increment", predictor.cpp: the explicit scheme's wall at any
   // lambda, but a moving body's coupling holds less: fluid/README.md).
   bool forcing_in_increment = false;  // fluid.implicit_forcing, default "after_solve"
+  // fluid.body_viscosity = "none": the fluid's viscous stress weighted by 1 − φ (φ the bodies'
+  // volume fraction), so that bodies are purely elastic (body_viscosity.cpp); "kelvin-voigt"
+  // (the default): the fluid's viscosity everywhere, bodies are Kelvin-Voigt with μ_s = μ_f.
+  bool bodies_inviscid = false;
   // Weight of first-order upwind in the convective fluxes outside the sponge (0: central).
   double upwind_blend = 0;
   int ranks = 0;  // [fluid] ranks: the ranks ./fsi launches the fluid on (0: not given)

@@ -141,12 +141,25 @@ Solver::Solver(const Config& c, double dt, MPI_Comm comm)
     m_slab_poisson = std::make_unique<SlabSolver>(pt, ps, 0.0, m_t_axis, ny, 0, comm);
     m_slab_poisson->set_mean_weights(w);
   }
+  if (c.implicit || c.bodies_inviscid) {
+    m_un = Field(nx + 1, ny, lo, hi);
+    m_vn = Field(nx, ny + 1, lo, vhi);
+  }
   if (c.implicit) {
     m_lu = Field(nx + 1, ny, lo, hi);
     m_lv = Field(nx, ny + 1, lo, vhi);
-    m_un = Field(nx + 1, ny, lo, hi);
-    m_vn = Field(nx, ny + 1, lo, vhi);
     build_implicit(dt);
+  }
+  if (c.bodies_inviscid) {
+    if (!m_dec.serial())
+      throw fsi::InputError(fmt::format(
+          "fluid.body_viscosity = \"none\" needs the fluid on one rank (it reads the volume "
+          "fractions of neighbouring rows); set ranks = 1 or body_viscosity = \"kelvin-voigt\" "
+          "(in {})",
+          c.source));
+    m_body_alpha = {Field(nx + 1, ny), Field(nx, ny + 1)};
+    m_body_mark = {std::vector<char>(std::size_t(nx + 1) * ny, 0),
+                   std::vector<char>(std::size_t(nx) * (ny + 1), 0)};
   }
   m_bnd.fill_ghosts(m_u, m_v);
   for (int s : {int(left), int(right)})
@@ -265,7 +278,8 @@ void Solver::begin_step(double dt) {
     const PhaseTimer t(m_time.predictor, m_time.cpu);
     explicit_terms();
   }
-  if (m_cfg.implicit) {  // u^n with t^n's boundary values and ghosts (predictor_implicit)
+  // u^n with t^n's boundary values and ghosts (predictor_implicit, remove_body_viscosity)
+  if (m_cfg.implicit || m_cfg.bodies_inviscid) {
     const PhaseTimer t(m_time.predictor, m_time.cpu);
     m_un = m_u;
     m_vn = m_v;
@@ -296,6 +310,7 @@ void Solver::end_step(double dt, const CouplingIn& in, CouplingOut& out) {
   {
     const PhaseTimer t(m_time.predictor, m_time.cpu);
     add_fiber_force(dt, in);
+    remove_body_viscosity(dt, in);
     if (m_cfg.implicit) solve_implicit(in);
     keep_predictor();
   }

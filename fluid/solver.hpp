@@ -148,6 +148,7 @@ class Solver {
   void add_fiber_force(double dt, const CouplingIn& fibers);                 // predictor.cpp
   void solve_implicit(const CouplingIn& in);                                 // predictor.cpp
   void immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out);  // forcing.cpp
+  void remove_body_viscosity(double dt, const CouplingIn& in);  // body_viscosity.cpp
   // dt, and the time whose boundary pressures p^(n+1) takes (t^n + dt; t^n for project_initial).
   void project(double dt, double t_new);                                    // projection.cpp
   // The face pressures at time t into m_face_p (pressure sides; per row; solver.cpp).
@@ -212,6 +213,10 @@ class Solver {
   // alpha (u_s - u^) per solid face of the coupling input (solve_implicit).
   Field m_un, m_vn;
   std::array<std::vector<double>, 2> m_pull;
+  // body_viscosity = "none": the volume fraction of the step's footprint per u, v face and a
+  // mark per face (body_viscosity.cpp), zero between steps.
+  std::array<Field, 2> m_body_alpha;
+  std::array<std::vector<char>, 2> m_body_mark;
   Timings m_time;
 };
 

@@ -33,8 +33,9 @@ def exact(y, t, h, mu_s=MU, rho_s=RHO_S):
     return np.real(np.outer(np.exp(1j * OMEGA * np.atleast_1d(t)), U))
 
 
-def scene(name, n, h, dt, t_end, rho_s=RHO_S):
-    """The scene on n cells across, the layer's top at y = h."""
+def scene(name, n, h, dt, t_end, rho_s=RHO_S, body_viscosity=None):
+    """The scene on n cells across, the layer's top at y = h; body_viscosity: the fluid's key of
+    that name ("none": a purely elastic layer, or "kelvin-voigt"), None for its default."""
     # The layer's top moves up to ~0.15 in x: a period of 0.25 keeps it within one period of
     # the box (the footprint of a body displaced by more than a period is not wrapped twice).
     width = 0.25
@@ -51,6 +52,7 @@ interval = {PERIOD / 16}
 density = {RHO_F}
 viscosity = {MU}
 diffusion = "implicit"
+{f'body_viscosity = "{body_viscosity}"' if body_viscosity else ""}
 [fluid.grid]
 cells = [{nx}, {n}]
 size = [{width!r}, 1.0]

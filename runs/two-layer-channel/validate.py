@@ -13,6 +13,9 @@ Crank-Nicolson forcing's leak (runs/sub-cell-wall), a fixed number of cells at a
 nu dt / h^2, then shrinks with h and the order is the space discretisation's (about 20 min).
   --fixed-dt  dt = 5e-4 on every grid (about 4 min; summary-fixed-dt.json): the leak grows from
               grid to grid (nu dt / h^2 = 0.128, 0.51, 2.05) and masks the order
+  --elastic   [fluid] body_viscosity = "none": the fluid's viscous stress weighted by 1 - phi,
+              none inside the layer; the reference is then the purely elastic layer (mu_s = 0), the
+              Kelvin-Voigt one reported beside it (summary-elastic.json)
 Environment: FSI_BIN, FSI_OUT, FSI_ROOT; FSI_MPIRUN (default mpirun)."""
 import os
 import shutil
@@ -30,9 +33,15 @@ from metrics import finish, metric  # noqa: E402
 
 p = cli.parser(__doc__)
 p.add_argument("--fixed-dt", action="store_true", help="dt = 5e-4 on every grid")
+p.add_argument("--elastic", action="store_true",
+               help='body_viscosity = "none", against the purely elastic layer')
 ARGS = p.parse_args()
 OUT = job.out_dir("two-layer-channel")
-SUFFIX = "-fixed-dt" if ARGS.fixed_dt else ""
+SUFFIX = ("-fixed-dt" if ARGS.fixed_dt else "") + ("-elastic" if ARGS.elastic else "")
+# The layer's model the run asks for, and the viscosity of the exact solution it is held to; the
+# other model's error is reported beside it.
+MODEL = "none" if ARGS.elastic else None
+MU_S, MU_OTHER = (0.0, tl.MU) if ARGS.elastic else (tl.MU, 0.0)
 
 DT = 5e-4
 T_END = 2.0 * tl.PERIOD if ARGS.short else 4.0 * tl.PERIOD
@@ -42,6 +51,11 @@ HEIGHTS = {"on": 0.5} if ARGS.short else {"on": 0.5, "off": 0.51}
 # Tolerances on the relative RMS error of the profile over the last period (max over phases).
 TOL_ERROR = {16: 0.05, 32: 0.03, 64: 0.02}
 TOL_ORDER = 0.8  # first order expected from the immersed-solid interface (paper Sec. 4.1)
+# The purely elastic layer's velocity reaches 0.78 V0 (the Kelvin-Voigt layer's 0.46 V0), and its
+# errors are larger on the same grid: first order from 0.08 on 16 cells. The Kelvin-Voigt layer
+# is 0.16-0.21 V0 from the elastic solution, beyond every one of these.
+if ARGS.elastic:
+    TOL_ERROR = {16: 0.08, 32: 0.04, 64: 0.02}
 
 
 def dt_for(n):
@@ -58,12 +72,14 @@ for where, h in HEIGHTS.items():
     errs = []
     for n in GRIDS:
         name = f"two-layer-{where}-{n}"
-        r = job.run(name, tl.scene(name, n, h, dt_for(n), T_END), work=work)
-        err, linf, yc, ts, us = tl.rms_error(r.folder, h, T_END)
+        r = job.run(name, tl.scene(name, n, h, dt_for(n), T_END, body_viscosity=MODEL),
+                    work=work)
+        err, linf, yc, ts, us = tl.rms_error(r.folder, h, T_END, mu_s=MU_S)
         errs.append(err)
-        rms_el = tl.rms_error(r.folder, h, T_END, mu_s=0.0)[0]
+        rms_other = tl.rms_error(r.folder, h, T_END, mu_s=MU_OTHER)[0]
+        other = "kelvin_voigt_layer" if ARGS.elastic else "elastic_layer"
         results[name] = {"cells_y": n, "h_s": h, "dt": dt_for(n), "rms_error": err,
-                         "max_error": linf, "rms_error_against_elastic_layer": rms_el,
+                         "max_error": linf, f"rms_error_against_{other}": rms_other,
                          "wall_s": r.wall, "cpu_s": r.cpu, "phases": len(ts)}
         print(f"[two-layer] {name}: rms error {err:.4e}, max error {linf:.4e} "
               f"({len(ts)} phases, {r.wall:.1f} s)", flush=True)
@@ -73,7 +89,7 @@ for where, h in HEIGHTS.items():
             yy = np.linspace(0, 1, 400)
             for k in range(0, len(ts), max(1, len(ts) // 4)):
                 line, = ax.plot(us[k], yc, "o", ms=3)
-                ax.plot(tl.exact(yy, ts[k], h)[0], yy, "-", color=line.get_color(), lw=0.8,
+                ax.plot(tl.exact(yy, ts[k], h, MU_S)[0], yy, "-", color=line.get_color(), lw=0.8,
                         label=f"t = {ts[k]:.3g}")
             ax.axhline(h, color="gray", lw=0.5, ls=":")
     if len(GRIDS) > 1:

@@ -124,6 +124,19 @@ TEST_CASE("implicit_forcing: read with Crank-Nicolson, refused without it or unk
                         Contains("Crank-Nicolson only"));
 }
 
+TEST_CASE("body_viscosity: kelvin-voigt by default, none, refused when unknown",
+          "[fluid][config]") {
+  CHECK_FALSE(read(kGood).bodies_inviscid);
+  CHECK(read(replace(kGood, "viscosity = 0.01", "viscosity = 0.01\nbody_viscosity = \"none\""))
+            .bodies_inviscid);
+  CHECK_FALSE(read(replace(kGood, "viscosity = 0.01",
+                           "viscosity = 0.01\nbody_viscosity = \"kelvin-voigt\""))
+                  .bodies_inviscid);
+  CHECK_THROWS_WITH(
+      read(replace(kGood, "viscosity = 0.01", "viscosity = 0.01\nbody_viscosity = \"elastic\"")),
+      Contains("body_viscosity") && Contains("elastic"));
+}
+
 TEST_CASE("pressure boundaries: where they are allowed", "[fluid][config][pressure]") {
   std::string open = replace(kGood, "left = { type = \"periodic\" }",
                              "left = { type = \"pressure\", value = 2.0, ramp = \"cosine\", ramp_time = 0.5 }");

@@ -270,3 +270,65 @@ TEST_CASE("Crank-Nicolson: the momentum gained is the returned forcing", "[fluid
   CHECK(std::abs(fint) > 1e-3);
   CHECK(momentum() - before == Approx(fint * dt).epsilon(1e-9));
 }
+
+// body_viscosity = "none" (body_viscosity.cpp): a layer of faces inside a body (alpha = 1) over
+// a shear u = y^2 (L u = 2 exactly on the uniform grid). Against the default, the forcing of a
+// face whose four links lie in the body grows by mu L u (the viscous force the fluid inside no
+// longer gets, so the body no longer receives it), the layer's edge rows by their inner link's
+// flux only (the link to the fluid keeps the traction), nothing changes outside the footprint,
+// and the changes sum to zero: the stress is moved, not lost.
+TEST_CASE("body_viscosity = none: no viscous force inside a body, the traction kept",
+          "[fluid][coupling]") {
+  for (Diffusion d : {explicit_ab2, crank_nicolson_after_solve}) {
+    CAPTURE(d);
+    const double dt = 1e-3;
+    std::vector<double> force[2], u_after[2];
+    std::vector<std::int32_t> iu;
+    std::vector<double> au, uu;
+    double mu = 0, h = 0;
+    for (int none = 0; none < 2; ++none) {
+      Config c = with(box(BcType::periodic), d);
+      c.bodies_inviscid = none == 1;
+      mu = c.viscosity;
+      Solver s(c, dt);
+      const Grid& g = s.grid();
+      h = g.y().h();
+      for (int j = -1; j <= g.ny(); ++j)
+        for (int i = -1; i <= g.nx(); ++i) {
+          const double y = (j + 0.5) * h;
+          s.u()(i, j) = y * y;
+        }
+      iu.clear(), au.clear(), uu.clear();
+      for (int j = 2; j < 6; ++j)
+        for (int i = 0; i < g.nx(); ++i)
+          iu.push_back(i + g.nu() * j), au.push_back(1.0), uu.push_back(s.u()(i, j));
+      CouplingIn in;
+      in.solid_u_index = iu;
+      in.solid_u_alpha = au;
+      in.solid_u_velocity = uu;
+      CouplingOut out;
+      s.step(dt, in, out);
+      force[none] = out.solid_u_force;
+      u_after[none] = s.u().a;
+    }
+    const int nx = 16;
+    double sum = 0, scale = 0;
+    for (std::size_t q = 0; q < iu.size(); ++q) {
+      const int j = iu[q] / nx;
+      const double y = (j + 0.5) * h;
+      const double change = force[1][q] - force[0][q];
+      // The flux the link to the row above (below) carried, mu (u_(j+1) - u_j) / h^2.
+      const double up = mu * ((y + h) * (y + h) - y * y) / (h * h);
+      const double down = mu * ((y - h) * (y - h) - y * y) / (h * h);
+      const double expected = j == 2 ? up : j == 5 ? down : 2 * mu;
+      // Explicit: exactly; Crank-Nicolson: the solve spreads the correction by O(lambda).
+      if (d == explicit_ab2) CHECK(change == Approx(expected).epsilon(1e-9));
+      else CHECK(change == Approx(expected).epsilon(0.02));
+      sum += change, scale += std::abs(change);
+    }
+    if (d == explicit_ab2) CHECK(std::abs(sum) <= 1e-9 * scale);
+    // Outside the footprint the explicit step's fields are the same (the forced faces end at
+    // u_s either way, and no fluid face was corrected).
+    if (d == explicit_ab2) CHECK(u_after[0] == u_after[1]);
+  }
+}
