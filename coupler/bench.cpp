@@ -5,7 +5,7 @@
 // two families one after the other) and wall time with the two families on two threads.
 // Then the feedback IB's per-step work on the paper's glycocalyx layout (16 fibers of 62 segments,
 // 1 008 markers, on a 128 x 96 grid periodic in x): the sampled velocities stored, each fiber's
-// interpolation and spreading, the next sample stencil and the spread forces taken (what the
+// interpolation, force and spreading in one pass, the next sample stencil and the spread forces taken (what the
 // coupler's "fibers" phase does), CPU time of this thread, best of five rounds.
 // Usage: bench_coupler [--out FILE.json] [--steps N]
 #include <algorithm>
@@ -83,7 +83,8 @@ double fiber_coupling_us(double sway, int steps) {
   coupler::FeedbackIB ib(g);
   const int fibers = 16, markers = 63;
   const double length = 0.125, ds = length / (markers - 1);
-  std::vector<std::vector<double>> x(fibers, std::vector<double>(2 * markers)), force = x;
+  std::vector<std::vector<double>> x(fibers, std::vector<double>(2 * markers)), x_old = x,
+      force = x;
   auto place = [&](int n) {  // clamped on a cosine wall, leaning with the arclength
     for (int k = 0; k < fibers; ++k) {
       const double x0 = (k + 0.5) / fibers, y0 = 0.2 + 0.05 * std::cos(2 * M_PI * x0);
@@ -91,12 +92,13 @@ double fiber_coupling_us(double sway, int steps) {
         const double s = m * ds;
         x[k][2 * m] = x0 + sway * std::sin(1e-3 * n + k) * s / length;
         x[k][2 * m + 1] = y0 + s;
+        x_old[k][2 * m] = x[k][2 * m] - 1e-6, x_old[k][2 * m + 1] = x[k][2 * m + 1] - 1e-6;
       }
     }
   };
   std::vector<std::int32_t> su, sv;
   fsi::proto::FaceForce fu, fv;
-  std::vector<double> u, us, vs;
+  std::vector<double> us, vs;
   double best = 1e300;
   for (int round = 0; round < 5; ++round) {
     place(0);
@@ -107,11 +109,7 @@ double fiber_coupling_us(double sway, int steps) {
       place(n);
       const double c0 = cpu_seconds();
       ib.store_samples(su, us, sv, vs);
-      for (int k = 0; k < fibers; ++k) {
-        ib.interpolate(x[k], u);
-        for (int m = 0; m < 2 * markers; ++m) force[k][m] = 1e3 * (1e-4 * u[m] - 1e-6);
-        ib.spread(x[k], force[k], ds);
-      }
+      for (int k = 0; k < fibers; ++k) ib.feedback(x[k], x_old[k], 1e3, 1e-4, ds, force[k]);
       ib.stencil(x, 1, su, sv);
       ib.take_spread(su, sv, fu, fv);
       cpu += cpu_seconds() - c0;
@@ -235,6 +233,13 @@ int main(int argc, char** argv) {
   std::printf(
       "  faces beyond a wall in one extra slot, so interpolation and spreading run without "
       "a branch per face; row offsets once per kernel row | -10 %% | 102 -> 98 us\n");
+  std::printf(
+      "  interpolation, force and spreading in one pass per marker, the kernel in registers "
+      "(was: 32 indices and weights per marker stored, then read twice); separable weights "
+      "(4 + 4, was 16 products); one direction's weights at a time (a packed square root had "
+      "stalled on its reload); inverse spacings; the kernel's faces without a call | -25 %% | "
+      "103-111 -> 73-77 us (another machine than the lines above; old and new alternately); "
+      "glycocalyx fibers phase / fluid compute 0.29-0.38 -> 0.20-0.30\n");
   if (out) {
     if (FILE* f = std::fopen(out, "w")) {
       auto fields = [&](const Result& r) {

@@ -135,7 +135,6 @@ class Coupler {
   bool m_kappa_given = false;
   bool m_have_samples = false;  // fluid velocity samples around the markers are stored
   std::vector<Root> m_roots;
-  std::vector<double> m_u_markers;  // scratch: U(X^n) of one fiber
   std::vector<ForceGroup> m_force_groups;
   std::vector<std::array<double, 2>> m_momentum;    // per body: ρ_f ∫ v dA at the last probe
   std::vector<std::array<double, 2>> m_body_force;  // per body: hydrodynamic force of this step

@@ -41,12 +41,11 @@ void Coupler::feedback_forces() {
     const auto& X = m_fiber.x[k];
     const auto& Xo = m_fiber.x_old[k];
     auto& F = m_fiber_in.force[k];
-    F.assign(X.size(), 0.0);
-    if (!m_have_samples) continue;
-    m_ib->interpolate(X, m_u_markers);
-    for (std::size_t m = 0; m < X.size(); ++m)
-      F[m] = m_kappa * (dt * m_u_markers[m] - (X[m] - Xo[m]));
-    m_ib->spread(X, F, m_layout.fibers[k].ds);
+    if (!m_have_samples) {
+      F.assign(X.size(), 0.0);
+      continue;
+    }
+    m_ib->feedback(X, Xo, m_kappa, dt, m_layout.fibers[k].ds, F);
   }
   // The next step's samples: the kernels of Xⁿ widened by a cell, which hold the faces spread to.
   m_ib->stencil(m_fiber.x, 1, m_fluid_in.sample_u, m_fluid_in.sample_v);

@@ -49,11 +49,22 @@ bool uniform(const std::vector<double>& f, double& h) {
 // bounded direction.
 void face_run(int i0, int n, bool periodic, int width, int* out) {
   if (periodic) {
-    int i = i0 % n;
-    if (i < 0) i += n;
+    // One period off at most for a marker near the domain; the division only beyond.
+    int i = i0 < 0 ? i0 + n : i0 >= n ? i0 - n : i0;
+    if (i < 0 || i >= n) i = ((i0 % n) + n) % n;
     for (int k = 0; k < width; ++k, i = i + 1 == n ? 0 : i + 1) out[k] = i;
   } else {
     for (int k = 0; k < width; ++k) out[k] = (i0 + k < 0 || i0 + k >= n) ? -1 : i0 + k;
+  }
+}
+
+// face_run for the four faces of a kernel, inlined for the common case of a kernel inside the
+// direction's faces.
+inline void kernel_run(int i0, int n, bool periodic, int* out) {
+  if (i0 >= 0 && i0 + 3 < n) {
+    for (int k = 0; k < 4; ++k) out[k] = i0 + k;
+  } else {
+    face_run(i0, n, periodic, 4, out);
   }
 }
 
@@ -63,6 +74,7 @@ FeedbackIB::FeedbackIB(const proto::GridInfo& g) {
   if (!uniform(g.x_face, m_hx) || !uniform(g.y_face, m_hy))
     fsi::fail("fibers need a uniform fluid grid (the delta function's moment conditions hold on "
               "a uniform grid only); this grid is stretched");
+  m_ihx = 1 / m_hx, m_ihy = 1 / m_hy;
   m_lx = g.x_face.back() - g.x_face.front();
   m_ly = g.y_face.back() - g.y_face.front();
   // u-faces at (x_face[i], y_centre[j]); v-faces at (x_centre[i], y_face[j]).
@@ -80,22 +92,63 @@ FeedbackIB::FeedbackIB(const proto::GridInfo& g) {
   }
 }
 
-void FeedbackIB::kernel(const Family& f, double X, double Y, std::int32_t idx[16], double w[16]) const {
-  const double sx = (X - f.x0) / m_hx, sy = (Y - f.y0) / m_hy;
-  const int i0 = floor_int(sx) - 1, j0 = floor_int(sy) - 1;
-  double wx[4], wy[4];
-  int ii[4], jj[4];
-  peskin4_weights(sx - (i0 + 1), wx);
-  peskin4_weights(sy - (j0 + 1), wy);
-  face_run(i0, f.ni, f.px, 4, ii);
-  face_run(j0, f.nj, f.py, 4, jj);
-  const std::int32_t outside = f.ni * f.nj;
-  for (int b = 0; b < 4; ++b) {
-    const std::int32_t row = jj[b] < 0 ? -1 : f.ni * jj[b];
-    for (int a = 0; a < 4; ++a) {
-      idx[4 * b + a] = (ii[a] < 0 || row < 0) ? outside : ii[a] + row;
-      w[4 * b + a] = wx[a] * wy[b];
+// The weights along one direction of a point at s (in cells from the family's first face) and
+// the first of its four faces.
+static inline int axis_weights(double s, double w[4]) {
+  const int i0 = floor_int(s) - 1;
+  peskin4_weights(s - (i0 + 1), w);
+  return i0;
+}
+
+// Each family's weights along x and y, face columns and row offsets. (One direction at a time,
+// in registers: computing the four square roots as a packed pair went through the stack, and
+// the pair's reload stalled on the two stores before it.)
+void FeedbackIB::kernel(double X, double Y, Kernel k[2]) const {
+  for (int c = 0; c < 2; ++c) {
+    const Family& f = c == 0 ? m_u : m_v;
+    Kernel& K = k[c];
+    const int i0 = axis_weights((X - f.x0) * m_ihx, K.wx);
+    const int j0 = axis_weights((Y - f.y0) * m_ihy, K.wy);
+    kernel_run(i0, f.ni, f.px, K.col);
+    kernel_run(j0, f.nj, f.py, K.row);
+    K.inner = true;
+    for (int d = 0; d < 4; ++d) {
+      K.inner &= K.col[d] >= 0 && K.row[d] >= 0;
+      if (K.row[d] >= 0) K.row[d] *= f.ni;
     }
+  }
+}
+
+// Face (a, b) of a kernel: its flat index, or `outside` beyond a bounded side.
+inline std::int32_t FeedbackIB::face(const Family& f, const Kernel& K, int a, int b) {
+  return K.inner || (K.col[a] >= 0 && K.row[b] >= 0) ? K.col[a] + K.row[b] : f.ni * f.nj;
+}
+
+// Σ_b φ_y,b Σ_a φ_x,a u(a, b) over the kernel's faces, and whether each was sampled. (The
+// arrays' pointers are taken once: the compiler cannot know the stores of scatter() leave them.)
+inline double FeedbackIB::gather(const Family& f, const Kernel& K, char& sampled) {
+  const double* value = f.value.data();
+  const char* has = f.has_value.data();
+  double s = 0;
+  for (int b = 0; b < 4; ++b) {
+    double t = 0;
+    for (int a = 0; a < 4; ++a) {
+      const std::int32_t id = K.inner ? K.col[a] + K.row[b] : face(f, K, a, b);
+      sampled &= has[id];
+      t += K.wx[a] * value[id];
+    }
+    s += K.wy[b] * t;
+  }
+  return s;
+}
+
+// force(a, b) += φ_x,a (φ_y,b t) on the kernel's faces.
+inline void FeedbackIB::scatter(Family& f, const Kernel& K, double t) {
+  double* force = f.force.data();
+  for (int b = 0; b < 4; ++b) {
+    const double tb = K.wy[b] * t;
+    for (int a = 0; a < 4; ++a)
+      force[K.inner ? K.col[a] + K.row[b] : face(f, K, a, b)] += K.wx[a] * tb;
   }
 }
 
@@ -114,8 +167,9 @@ void FeedbackIB::stencil(const std::vector<std::vector<double>>& markers, int ma
     cells.clear();
     for (const auto& x : markers) {
       for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
-        const double sx = (x[m] - f->x0) / m_hx, sy = (x[m + 1] - f->y0) / m_hy;
-        // floor_int needs int's range; a marker this far off is lost anyway.
+        const double sx = (x[m] - f->x0) * m_ihx, sy = (x[m + 1] - f->y0) * m_ihy;
+        // floor_int needs int's range; a marker this far off is lost anyway. The same products as
+        // kernel()'s, so that a marker on a face line falls in the same cell in both.
         if (!(std::abs(sx) < kFarCells && std::abs(sy) < kFarCells))
           fsi::fail("fiber marker at ({}, {}) is not finite or far outside the fluid grid", x[m],
                     x[m + 1]);
@@ -170,58 +224,59 @@ void FeedbackIB::store_samples(const std::vector<std::int32_t>& u_faces, const s
   }
 }
 
-void FeedbackIB::kernels(const std::vector<double>& x) const {
-  if (x == m_kernel_x) return;
-  const std::size_t markers = x.size() / 2;
-  m_idx.resize(32 * markers), m_w.resize(32 * markers);
-  for (std::size_t m = 0; m < markers; ++m) {
-    if (!(std::abs(x[2 * m] - m_u.x0) < kFarCells * m_hx &&
-          std::abs(x[2 * m + 1] - m_v.y0) < kFarCells * m_hy))
-      fsi::fail("fiber marker at ({}, {}) is not finite or far outside the fluid grid", x[2 * m],
-                x[2 * m + 1]);
-    for (int c = 0; c < 2; ++c)
-      kernel(c == 0 ? m_u : m_v, x[2 * m], x[2 * m + 1], &m_idx[32 * m + 16 * c],
-             &m_w[32 * m + 16 * c]);
-  }
-  m_kernel_x = x;
+void FeedbackIB::check_marker(double X, double Y) const {
+  if (!(std::abs(X - m_u.x0) < kFarCells * m_hx && std::abs(Y - m_v.y0) < kFarCells * m_hy))
+    fsi::fail("fiber marker at ({}, {}) is not finite or far outside the fluid grid", X, Y);
+}
+
+void FeedbackIB::unsampled(double X, double Y) {
+  fsi::fail("fiber marker at ({}, {}) moved beyond the sampled stencil in one step (more than a "
+            "grid cell): reduce dt",
+            X, Y);
 }
 
 void FeedbackIB::interpolate(const std::vector<double>& x, std::vector<double>& u) const {
-  kernels(x);
   u.assign(x.size(), 0.0);
+  Kernel k[2];
   for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
-    for (int c = 0; c < 2; ++c) {
-      const Family& f = c == 0 ? m_u : m_v;
-      const std::int32_t* idx = &m_idx[16 * m + 16 * c];
-      const double* w = &m_w[16 * m + 16 * c];
-      double s = 0;
-      char sampled = 1;
-      for (int k = 0; k < 16; ++k) {
-        sampled &= f.has_value[idx[k]];
-        s += w[k] * f.value[idx[k]];
-      }
-      if (!sampled)
-        fsi::fail(
-            "fiber marker at ({}, {}) moved beyond the sampled stencil in one step "
-            "(more than a grid cell): reduce dt",
-            x[m], x[m + 1]);
-      u[m + c] = s;
-    }
+    check_marker(x[m], x[m + 1]);
+    kernel(x[m], x[m + 1], k);
+    char sampled = 1;
+    for (int c = 0; c < 2; ++c) u[m + c] = gather(c == 0 ? m_u : m_v, k[c], sampled);
+    if (!sampled) unsampled(x[m], x[m + 1]);
   }
 }
 
 void FeedbackIB::spread(const std::vector<double>& x, const std::vector<double>& F, double ds) {
-  kernels(x);
   const std::size_t last = x.size() - 2;
+  Kernel k[2];
   for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
+    check_marker(x[m], x[m + 1]);
+    kernel(x[m], x[m + 1], k);
     const double scale = -(m == 0 || m == last ? 0.5 * ds : ds) / (m_hx * m_hy);
+    for (int c = 0; c < 2; ++c) scatter(c == 0 ? m_u : m_v, k[c], scale * F[m + c]);
+  }
+}
+
+void FeedbackIB::feedback(const std::vector<double>& x, const std::vector<double>& x_old,
+                          double kappa, double dt, double ds, std::vector<double>& F) {
+  if (x_old.size() != x.size())
+    fsi::fail("fiber feedback: {} marker coordinates now, {} before", x.size(), x_old.size());
+  F.resize(x.size());
+  const std::size_t last = x.size() - 2;
+  Kernel k[2];
+  for (std::size_t m = 0; m + 1 < x.size(); m += 2) {
+    check_marker(x[m], x[m + 1]);
+    kernel(x[m], x[m + 1], k);
+    const double scale = -(m == 0 || m == last ? 0.5 * ds : ds) / (m_hx * m_hy);
+    char sampled = 1;
     for (int c = 0; c < 2; ++c) {
-      double* force = (c == 0 ? m_u : m_v).force.data();
-      const std::int32_t* idx = &m_idx[16 * m + 16 * c];
-      const double* w = &m_w[16 * m + 16 * c];
-      const double s = scale * F[m + c];
-      for (int k = 0; k < 16; ++k) force[idx[k]] += s * w[k];
+      Family& f = c == 0 ? m_u : m_v;
+      const double U = gather(f, k[c], sampled);
+      F[m + c] = kappa * (dt * U - (x[m + c] - x_old[m + c]));
+      scatter(f, k[c], scale * F[m + c]);
     }
+    if (!sampled) unsampled(x[m], x[m + 1]);
   }
 }
 

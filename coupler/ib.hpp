@@ -44,8 +44,6 @@ class FeedbackIB {
 
   // U(X) = Σ_faces u_f φ((x_f − X)/h_x) φ((y_f − Y)/h_y) at each marker, from stored samples. A
   // face of the kernel that was not sampled is an error (a marker moved more than the margin).
-  // The kernels are kept for a spread() of the same markers that follows (the feedback force's
-  // interpolation and spreading use the same Xⁿ).
   void interpolate(const std::vector<double>& x, std::vector<double>& u) const;
 
   // The force per unit volume on the fluid from forces per unit length F on the markers of one
@@ -53,6 +51,13 @@ class FeedbackIB {
   // w_m = ds inside and ds/2 at the two ends (the weights the fiber integrates its loads with, so
   // that action = reaction), accumulated per face.
   void spread(const std::vector<double>& x, const std::vector<double>& F, double ds);
+  // The feedback force of one fiber in one pass over its markers (feedback.cpp, Eq. 23-25): at
+  // each marker the kernels of X_m, U(X_m) from the stored samples, the force per unit length
+  //   F_m = κ (Δt U(X_m) − (X_m − X_old,m))
+  // into F, and F_m spread as spread() does: the same sums, in the same order, as interpolate(),
+  // the force and spread(), with one kernel evaluation per marker.
+  void feedback(const std::vector<double>& x, const std::vector<double>& x_old, double kappa,
+                double dt, double ds, std::vector<double>& F);
   // The accumulated spread force as sparse face lists (sorted), then cleared. u_faces, v_faces:
   // a stencil() (any margin) of every marker spread since the last take: it holds every face
   // they touched.
@@ -85,19 +90,26 @@ class FeedbackIB {
   // marker more than kFarCells cells from the grid's origin).
   static constexpr int kFiberEnd = std::numeric_limits<int>::min();
   static constexpr double kFarCells = 1e9;
-  // The 4 × 4 kernel of point (X, Y) on a family: face indices (`outside` beyond a bounded
-  // side) and weights φ φ.
-  void kernel(const Family& f, double X, double Y, std::int32_t idx[16], double w[16]) const;
-  // The kernels of both families at every marker of x into m_idx, m_w (16 per marker and family),
-  // unless they are those of the same x already.
-  void kernels(const std::vector<double>& x) const;
+  // The 4 × 4 kernel of a point on one family: the face columns and the row offsets (ni · row)
+  // it spans (−1 beyond a bounded side) and the weights along x and y; `inner` when none is
+  // beyond a side (face (a, b) is then col[a] + row[b]).
+  struct Kernel {
+    int col[4], row[4];
+    double wx[4], wy[4];
+    bool inner;
+  };
+  // The kernels of point (X, Y) on the u faces (k[0]) and the v faces (k[1]).
+  void kernel(double X, double Y, Kernel k[2]) const;
+  static std::int32_t face(const Family& f, const Kernel& K, int a, int b);
+  static double gather(const Family& f, const Kernel& K, char& sampled);
+  static void scatter(Family& f, const Kernel& K, double t);
+  // A clear error for a marker that is not finite or too far off for the kernels' integers.
+  void check_marker(double X, double Y) const;
+  // The error of a marker whose kernel reaches a face that was not sampled.
+  [[noreturn]] static void unsampled(double X, double Y);
 
-  double m_hx, m_hy, m_lx, m_ly;
+  double m_hx, m_hy, m_ihx, m_ihy, m_lx, m_ly;
   Family m_u, m_v;
-  // Cache of kernels(): the markers the kernels belong to, their indices and weights.
-  mutable std::vector<double> m_kernel_x;
-  mutable std::vector<std::int32_t> m_idx;
-  mutable std::vector<double> m_w;
 };
 
 }  // namespace coupler
