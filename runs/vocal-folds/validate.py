@@ -17,6 +17,10 @@ contact between them.
   t >= 1, the dominant frequency and the nearest eigenfrequency, the amplitude, contact, forces
   and impulses; spectra.png (Fig. 13), frequency.png, trajectories.png (Fig. 14), forces_h0.png
   (Fig. 15), fields.png (Fig. 12); the paper's findings reported, only "ran to t_end" judged.
+--material neo-hookean: the folds' cover and body neo-Hookean with the same small-strain E and nu
+  (the paper: St.Venant-Kirchhoff, which loses its stiffness under strong compression; README),
+  every output under OUT/neo-hookean. --clearances H,H,...: the sweep's velocity-inflow runs at
+  these clearances only (and no pressure-inlet run).
 With no option (`./fsi validate vocal-folds`): --modes, --short and --sweep."""
 import fcntl
 import json
@@ -55,12 +59,19 @@ P.add_argument("--sweep", action="store_true",
                help="the clearance sweep h = 0, 0.01, 0.02, 0.04, 0.05 (and h = 0 at P = 5000), with --modes")
 P.add_argument("--no-run", action="store_true",
                help="--sweep: start no run, process only the runs that are there")
+P.add_argument("--material", choices=("saint-venant-kirchhoff", "neo-hookean"),
+               default="saint-venant-kirchhoff", help="the folds' material (the paper's by default)")
+P.add_argument("--clearances", type=lambda s: [float(v) for v in s.split(",")], default=None,
+               help="--sweep: only these clearances, velocity inflow")
 ARGS = P.parse_args()
 if not (ARGS.modes or ARGS.short or ARGS.run is not None or ARGS.sweep):
     ARGS.modes = ARGS.short = ARGS.sweep = True
 if ARGS.sweep:
     ARGS.modes = True  # the sweep compares with the fold's eigenfrequencies and mode shapes
 OUT = job.out_dir("vocal-folds")
+if ARGS.material != "saint-venant-kirchhoff":
+    OUT = job.OUT = os.path.join(OUT, ARGS.material)
+    os.makedirs(OUT, exist_ok=True)
 HERE = os.path.dirname(os.path.abspath(__file__))
 GEO = os.path.join(HERE, "fold.geo")
 PAPER_MODES = (1.85, 4.12, 5.45)
@@ -72,6 +83,7 @@ def scene(h, grid="paper", t_end=10.0, interval=0.05, ramp=None, fluid=True, mod
     sponge cells along); without fluid, the solid alone (for the modes)."""
     text = open(os.path.join(HERE, "scene.toml")).read()
     text = text.replace('mesh = "fold.geo"', f'mesh = "{GEO}"')
+    text = text.replace('model = "saint-venant-kirchhoff"', f'model = "{ARGS.material}"')
     text = text.replace("h = 0.02", f"h = {h!r}").replace("0.52]", f"{0.5 + h!r}]")
     nx, ny, sponge, ratio = (560, round(100 * (1 + h)), 40, 1.05) if grid == "paper" else \
         (140, round(25 * (1 + h)), 10, 1.2)
@@ -619,7 +631,8 @@ def sweep_plots(rows, modes_f, x_ref, shapes):
 
 if ARGS.sweep:
     t_end, upwind = ARGS.t_end or 6.0, ARGS.upwind if ARGS.upwind is not None else 0.2
-    rows = [sweep_case(h, p, ARGS.grid, t_end, upwind, f1) for h, p in SWEEP_CASES]
+    cases = SWEEP_CASES if ARGS.clearances is None else [(h, None) for h in ARGS.clearances]
+    rows = [sweep_case(h, p, ARGS.grid, t_end, upwind, f1) for h, p in cases]
     sweep_plots(rows, f1, x_ref, shapes)
     print(f"\nsweep ({ARGS.grid} grid, t_end {t_end:g}, upwind_blend {upwind:g}); spectra over t >= {SETTLE}; "
           f"modes of one fold {', '.join(f'{v:.3f}' for v in f1)}")
