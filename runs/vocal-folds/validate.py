@@ -597,8 +597,9 @@ def sweep_plots(rows, modes_f, x_ref, shapes):
     fig.savefig(os.path.join(OUT, "forces_h0.png"), dpi=120)
     plt.close(fig)
     # Fig. 12: |u| near the folds closed (smallest gap at an output step) and open (largest gap
-    # after t = 1), for h = 0 with the pressure inlet and for h = 0.02.
-    sel = [r for r in rows if (r["h"] == 0 and r["inlet"] != "velocity")
+    # after t = 1), for h = 0 (the velocity inflow when it ran to the end, the pressure inlet)
+    # and for h = 0.02.
+    sel = [r for r in rows if (r["h"] == 0 and (r["inlet"] != "velocity" or r["state"] == "finished"))
            or (r["h"] == 0.02 and r["inlet"] == "velocity")]
     fig, ax = plt.subplots(max(len(sel), 1), 2, figsize=(12, 3.6 * max(len(sel), 1)), squeeze=False)
     for i, r in enumerate(sel):
