@@ -8,19 +8,22 @@ namespace fluid {
 // The immersed solid's forcing holds the fluid inside a body at the body's velocity, and the
 // fluid's momentum equation there keeps its viscous term; through the reaction the body receives
 // it, so a body behaves as a Kelvin-Voigt solid with μ_s = μ_f (runs/two-layer-channel). With
-// body_viscosity = "none" the fluid's stress is that of a mixture, (1 − φ) μ ∇u, φ the bodies'
-// volume fraction, so that a body carries only its own (elastic) stress. Discretely the
-// predictor's viscous term ν L uⁿ becomes ν L_(1−φ) uⁿ: on each face f
-//   ũ_f −= Δt ν Σ_g φ_fg c_fg (uⁿ_g − uⁿ_f),
-// g the four neighbours of f in the MAC Laplacian L (c_fg its coefficients: the same
-// differences as momentum.cpp), φ_fg = min(α_f, α_g) (α from the coupling input, capped at 1):
-// the flux between two faces is taken out as far as both control volumes lie in a body. A link
-// with a face of the fluid (α = 0) keeps its flux, so the fluid's traction on a body's surface
-// stays whole and only faces of the footprint change. Each flux between two faces is taken out
-// on both with the same difference, so where L conserves momentum L_(1−φ) does too (the mean
-// (α_f + α_g)/2 would halve the traction where a surface lies on a grid line). Crank-Nicolson:
-// the explicit prediction û carries ν Δt L uⁿ (predictor.cpp) and takes the same correction
-// before its solve; the solve's ½ ν Δt L₀ (ũ − uⁿ) is left inside the body, O(Δt).
+// body_viscosity = "none" the fluid's stress is that of a mixture, (1 − φ) 2μ D(u), φ the bodies'
+// volume fraction, so that a body carries only its own (elastic) stress. The predictor's viscous
+// term ν L uⁿ = ν div(∇uⁿ) (= ν div(2D(uⁿ)) for div u = 0 and uniform ν) loses
+// ν div(φ 2D(uⁿ)) on the footprint; in the symmetric form, so that a rigid motion (D = 0) is left
+// alone and a body's surface keeps the whole traction, normal and tangential. On the MAC grid:
+//   u face (i, j):  2 ∂x(φ ∂x u) + ∂y(φ (∂y u + ∂x v)),   v face:  ∂x(φ (∂y u + ∂x v)) + 2 ∂y(φ ∂y v),
+// with ∂x u, ∂y v at the cell centres between two faces (the Laplacian's differences, momentum.cpp)
+// and ∂y u + ∂x v at the cell corners, each divided by the Laplacian's widths. φ is the smallest
+// α of the faces a difference reads: the two faces at a centre, the four around a corner (α from
+// the coupling input, capped at 1). A face beyond a wall, or a boundary face (no unknown), does
+// not count, so a body on a wall loses the wall's shear too. A difference that reads a fluid face
+// (α = 0) keeps its flux. Every flux is taken out on both faces it joins, so momentum is
+// conserved where L conserves it. Explicit in uⁿ: with AB2 the extrapolated part
+// ½ ν Δt/Δt' L (uⁿ − uⁿ⁻¹) stays, O(Δt). Crank-Nicolson: û carries ν Δt L uⁿ (predictor.cpp) and
+// takes the same correction before its solve; the solve's ½ ν Δt L₀ (ũ − uⁿ) is left inside the
+// body, O(Δt).
 //
 // F holds the prediction (ũ or û); uⁿ is m_un, m_vn. One rank only (checked at set-up).
 void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
@@ -31,58 +34,69 @@ void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
   const Axis& Y = m_grid.y();
   const double *xwi = X.wi(), *xdi = X.di(), *xci = X.ci();
   const double *ywi = Y.wi(), *ydi = Y.di(), *yci = Y.ci();
-  for (int comp = 0; comp < 2; ++comp) {
-    Field& F = comp == 0 ? m_u : m_v;
-    const Field& Fn = comp == 0 ? m_un : m_vn;
-    Field& A = m_body_alpha[comp];
-    std::vector<char>& mark = m_body_mark[comp];
-    const auto& idx = comp == 0 ? in.solid_u_index : in.solid_v_index;
-    const auto& alpha = comp == 0 ? in.solid_u_alpha : in.solid_v_alpha;
-    // Faces along x and y of this family (a periodic direction's last face is its first).
-    const int ni = comp == 0 ? (px ? nx : nx + 1) : nx;
-    const int nj = comp == 0 ? ny : (py ? ny : ny + 1);
-    // The faces whose velocity the step solves for.
-    const int i_lo = comp == 0 ? m_iu0 : 0, i_hi = comp == 0 ? m_iu1 : nx;
-    const int j_lo = comp == 0 ? 0 : m_j0, j_hi = ny;
-    auto wrap = [](int k, int n, bool periodic) { return periodic ? (k + n) % n : k; };
-    auto inside = [&](int i, int j) { return i >= 0 && i < ni && j >= 0 && j < nj; };
-    auto a_at = [&](int i, int j) {
-      i = wrap(i, ni, px), j = wrap(j, nj, py);
-      return inside(i, j) ? A(i, j) : 0.0;
-    };
-    for (std::size_t q = 0; q < idx.size(); ++q) {
-      const auto [i, j] = face_of(comp, idx[q]);
-      A(i, j) = std::min(1.0, A(i, j) + alpha[q]);
+  // Faces along x and y of each family (a periodic direction's last face is its first), and
+  // the faces whose velocity the step solves for: [i_lo, i_hi) x [j_lo, j_hi).
+  const int ni[2] = {px ? nx : nx + 1, nx}, nj[2] = {ny, py ? ny : ny + 1};
+  const int i_lo[2] = {m_i0, 0}, i_hi[2] = {nx, nx};
+  const int j_lo[2] = {0, m_j0}, j_hi[2] = {ny, ny};
+  const std::span<const std::int32_t> idx[2] = {in.solid_u_index, in.solid_v_index};
+  const std::span<const double> alpha[2] = {in.solid_u_alpha, in.solid_v_alpha};
+  auto wrap = [](int k, int n, bool periodic) { return periodic ? (k + n) % n : k; };
+  // α of face (i, j) of family c for the minima: 1 (no say) beyond a wall or on a boundary face.
+  auto a_at = [&](int c, int i, int j) {
+    i = wrap(i, ni[c], px), j = wrap(j, nj[c], py);
+    if (i < i_lo[c] || i >= i_hi[c] || j < j_lo[c] || j >= j_hi[c]) return 1.0;
+    return m_body_alpha[c](i, j);
+  };
+  for (int c = 0; c < 2; ++c)
+    for (std::size_t q = 0; q < idx[c].size(); ++q) {
+      const auto [i, j] = face_of(c, idx[c][q]);
+      double& a = m_body_alpha[c](i, j);
+      a = std::min(1.0, a + alpha[c][q]);
     }
-    // −Δt ν Σ_g φ_fg c_fg (uⁿ_g − uⁿ_f) on each face of the footprint, once.
-    for (std::size_t q = 0; q < idx.size(); ++q) {
-      const auto [i, j] = face_of(comp, idx[q]);
-      if (i < i_lo || i >= i_hi || j < j_lo || j >= j_hi) continue;
-      char& m = mark[std::size_t(i) + std::size_t(ni) * j];
+  const Field& U = m_un;
+  const Field& V = m_vn;
+  // φ at the corner (x face i, y face j): u faces (i, j − 1), (i, j); v faces (i − 1, j), (i, j).
+  auto corner = [&](int i, int j) {
+    return std::min(std::min(a_at(0, i, j - 1), a_at(0, i, j)),
+                    std::min(a_at(1, i - 1, j), a_at(1, i, j)));
+  };
+  // ∂y u + ∂x v at that corner.
+  auto shear = [&](int i, int j) {
+    return (U(i, j) - U(i, j - 1)) * ydi[j] + (V(i, j) - V(i - 1, j)) * xdi[i];
+  };
+  for (int c = 0; c < 2; ++c) {
+    Field& F = c == 0 ? m_u : m_v;
+    std::vector<char>& mark = m_body_mark[c];
+    for (std::size_t q = 0; q < idx[c].size(); ++q) {
+      const auto [i, j] = face_of(c, idx[c][q]);
+      if (i < i_lo[c] || i >= i_hi[c] || j < j_lo[c] || j >= j_hi[c]) continue;
+      char& m = mark[std::size_t(i) + std::size_t(ni[c]) * j];
       if (m) continue;
       m = 1;
-      const double a = A(i, j), c = Fn(i, j);
-      double cx_e, cx_w, cy_n, cy_s;  // coefficients of the east, west, north, south links
-      if (comp == 0) {
-        cx_e = xwi[i] * xdi[i], cx_w = xwi[i - 1] * xdi[i];
-        cy_n = ydi[j + 1] * yci[j], cy_s = ydi[j] * yci[j];
+      const double a = a_at(c, i, j);
+      double d;
+      if (c == 0) {
+        const double c0 = U(i, j);
+        d = 2 * (std::min(a, a_at(0, i + 1, j)) * (U(i + 1, j) - c0) * xwi[i] -
+                 std::min(a, a_at(0, i - 1, j)) * (c0 - U(i - 1, j)) * xwi[i - 1]) * xdi[i] +
+            (corner(i, j + 1) * shear(i, j + 1) - corner(i, j) * shear(i, j)) * yci[j];
       } else {
-        cx_e = xdi[i + 1] * xci[i], cx_w = xdi[i] * xci[i];
-        cy_n = ywi[j] * ydi[j], cy_s = ywi[j - 1] * ydi[j];
+        const double c0 = V(i, j);
+        d = (corner(i + 1, j) * shear(i + 1, j) - corner(i, j) * shear(i, j)) * xci[i] +
+            2 * (std::min(a, a_at(1, i, j + 1)) * (V(i, j + 1) - c0) * ywi[j] -
+                 std::min(a, a_at(1, i, j - 1)) * (c0 - V(i, j - 1)) * ywi[j - 1]) * ydi[j];
       }
-      const double d = std::min(a, a_at(i + 1, j)) * cx_e * (Fn(i + 1, j) - c) +
-                       std::min(a, a_at(i - 1, j)) * cx_w * (Fn(i - 1, j) - c) +
-                       std::min(a, a_at(i, j + 1)) * cy_n * (Fn(i, j + 1) - c) +
-                       std::min(a, a_at(i, j - 1)) * cy_s * (Fn(i, j - 1) - c);
       F(i, j) -= dt * m_nu * d;
     }
-    // Back to zero for the next step (the footprint moves).
-    for (std::size_t q = 0; q < idx.size(); ++q) {
-      const auto [i, j] = face_of(comp, idx[q]);
-      A(i, j) = 0;
-      mark[std::size_t(i) + std::size_t(ni) * j] = 0;
-    }
   }
+  // Back to zero for the next step (the footprint moves).
+  for (int c = 0; c < 2; ++c)
+    for (std::size_t q = 0; q < idx[c].size(); ++q) {
+      const auto [i, j] = face_of(c, idx[c][q]);
+      m_body_alpha[c](i, j) = 0;
+      m_body_mark[c][std::size_t(i) + std::size_t(ni[c]) * j] = 0;
+    }
 }
 
 }  // namespace fluid

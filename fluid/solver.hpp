@@ -209,8 +209,9 @@ class Solver {
   // Crank-Nicolson: the boundary increment of the step's solve, per component, in the Helmholtz
   // solver's layout (predictor_implicit), until its solve.
   std::array<std::vector<double>, 2> m_rhs;
-  // Crank-Nicolson: u^n (with t^n's boundary values and ghosts) during the step, and the forcing
-  // alpha (u_s - u^) per solid face of the coupling input (solve_implicit).
+  // Crank-Nicolson or body_viscosity = "none": u^n (with t^n's boundary values and ghosts) during
+  // the step; Crank-Nicolson: the forcing alpha (u_s - u^) per solid face of the coupling input
+  // (solve_implicit).
   Field m_un, m_vn;
   std::array<std::vector<double>, 2> m_pull;
   // body_viscosity = "none": the volume fraction of the step's footprint per u, v face and a
