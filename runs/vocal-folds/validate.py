@@ -714,4 +714,5 @@ if ARGS.sweep:
     extra["sweep_settings"] = {"grid": ARGS.grid, "t_end": t_end, "upwind_blend": upwind, "settle": SETTLE,
                                "sustained": SUSTAINED, "moves": MOVES, "modes_one_fold": f1}
 
+extra["material"] = ARGS.material
 finish("vocal-folds", metrics, extra, short=ARGS.short and not ARGS.modes)
