@@ -22,6 +22,21 @@ Config box(BcType xb) {
   return c;
 }
 
+// The immersed input: faces, volume fractions and solid velocities of the u and v families (the
+// vectors must outlive the spans of the result).
+CouplingIn solid_input(const std::vector<std::int32_t>& iu, const std::vector<double>& au,
+                       const std::vector<double>& uu, const std::vector<std::int32_t>& iv,
+                       const std::vector<double>& av, const std::vector<double>& vv) {
+  CouplingIn in;
+  in.solid_u_index = iu;
+  in.solid_u_alpha = au;
+  in.solid_u_velocity = uu;
+  in.solid_v_index = iv;
+  in.solid_v_alpha = av;
+  in.solid_v_velocity = vv;
+  return in;
+}
+
 // Faces (4..7, 3) of a solid block moving at 0.3 with alpha 0.6: the immersed input of the
 // bit-identity tests below (the vectors must outlive the spans of `in`).
 struct BlockInput {
@@ -89,13 +104,7 @@ TEST_CASE("immersed-solid forcing returns f_s and drives the faces to the solid 
       au.push_back(1.0);
       uu.push_back(5.0);
     }
-    CouplingIn in;
-    in.solid_u_index = iu;
-    in.solid_u_alpha = au;
-    in.solid_u_velocity = uu;
-    in.solid_v_index = iv;
-    in.solid_v_alpha = av;
-    in.solid_v_velocity = vv;
+    CouplingIn in = solid_input(iu, au, uu, iv, av, vv);
     in.sample_u_index = iu;
     CouplingOut out;
     s.step(dt, in, out);
@@ -308,13 +317,7 @@ TEST_CASE("body_viscosity = none: no viscous force inside a body, the traction k
       for (int j = 2; j <= 6; ++j)
         for (int i = 0; i < g.nx(); ++i)
           iv.push_back(i + g.nx() * j), av.push_back(j == 2 || j == 6 ? 0.5 : 1.0), vv.push_back(0);
-      CouplingIn in;
-      in.solid_u_index = iu;
-      in.solid_u_alpha = au;
-      in.solid_u_velocity = uu;
-      in.solid_v_index = iv;
-      in.solid_v_alpha = av;
-      in.solid_v_velocity = vv;
+      const CouplingIn in = solid_input(iu, au, uu, iv, av, vv);
       CouplingOut out;
       s.step(dt, in, out);
       force[none] = out.solid_u_force;
@@ -373,9 +376,7 @@ TEST_CASE("body_viscosity = none leaves a rigid rotation alone", "[fluid][coupli
           a[c2].push_back(edge ? 0.5 : 1.0);
           w[c2].push_back(c2 == 0 ? -omega * (y - yc) : omega * (x - xc));
         }
-    CouplingIn in;
-    in.solid_u_index = idx[0], in.solid_u_alpha = a[0], in.solid_u_velocity = w[0];
-    in.solid_v_index = idx[1], in.solid_v_alpha = a[1], in.solid_v_velocity = w[1];
+    const CouplingIn in = solid_input(idx[0], a[0], w[0], idx[1], a[1], w[1]);
     CouplingOut out;
     s.step(dt, in, out);
     force[none][0] = out.solid_u_force, force[none][1] = out.solid_v_force;
