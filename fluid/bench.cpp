@@ -78,9 +78,12 @@ int main(int argc, char** argv) {
   fmt::print("{:<20} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>7} {:>7}\n", "grid", "pred ms",
              "bc ms", "poiss ms", "proj ms", "step ms", "ns/cell", "floor ms", "step/fl", "poi/fl");
   for (const Case& k : {cavity(256), channel(750, 123), channel(1500, 246)}) {
-    for (bool implicit : {false, true}) {
+    // explicit; Crank-Nicolson with the direct Helmholtz solves; with the factored ones
+    for (int mode = 0; mode < 3; ++mode) {
+      const bool implicit = mode > 0;
       Config c = k.cfg;
       c.implicit = implicit;
+      c.factored_helmholtz = mode == 2;
       c.cfl_max = 1e9;
       Solver s(c, k.dt);
       set_initial(s);
@@ -102,7 +105,7 @@ int main(int argc, char** argv) {
       const double step = el / steps;
       const double ms = 1e3 / steps;
       const double ratio = step / floor, poisson_ratio = tm.poisson / steps / floor;
-      const std::string name = k.name + (implicit ? " CN" : "");
+      const std::string name = k.name + (mode == 2 ? " CN-fact" : implicit ? " CN" : "");
       fmt::print("{:<20} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.1f} {:>9.3f} {:>7.2f} {:>7.2f}\n",
                  name, tm.predictor * ms, tm.boundaries * ms, tm.poisson * ms, tm.projection * ms,
                  step * 1e3, step / cells * 1e9, floor * 1e3, ratio, poisson_ratio);
@@ -110,6 +113,7 @@ int main(int argc, char** argv) {
                             {"nx", s.grid().nx()},
                             {"ny", s.grid().ny()},
                             {"diffusion", implicit ? "implicit" : "explicit"},
+                            {"helmholtz", mode == 2 ? "factored" : implicit ? "direct" : "none"},
                             {"steps", steps},
                             {"ms_per_step",
                              {{"predictor", tm.predictor * ms},

@@ -91,6 +91,18 @@ Operator1D make_operator(const Axis& ax, Loc loc, bool transform, const Boundari
   return op;
 }
 
+// The same operator as tridiagonal rows in any direction (the factored Helmholtz solve): a
+// periodic direction (uniform) gets rows whose a[0] and c[n-1] wrap around.
+Operator1D tridiagonal_operator(const Axis& ax, Loc loc, const Boundaries& b, int side_lo) {
+  Operator1D op = make_operator(ax, loc, false, b, side_lo);
+  if (op.lo != Closure::periodic) return op;
+  const double k = 1.0 / (op.h * op.h);
+  op.a.assign(op.n, k);
+  op.c.assign(op.n, k);
+  op.b.assign(op.n, -2 * k);
+  return op;
+}
+
 }  // namespace
 
 Solver::Solver(const Config& c, double dt, MPI_Comm comm)
@@ -145,6 +157,11 @@ Solver::Solver(const Config& c, double dt, MPI_Comm comm)
     m_un = Field(nx + 1, ny, lo, hi);
     m_vn = Field(nx, ny + 1, lo, vhi);
   }
+  if (c.implicit && c.factored_helmholtz && !m_dec.serial())
+    throw fsi::InputError(fmt::format(
+        "fluid.helmholtz = \"factored\" needs the fluid on one rank (its sweeps run along both "
+        "grid directions); set ranks = 1 or helmholtz = \"direct\" (in {})",
+        c.source));
   if (c.implicit) {
     m_lu = Field(nx + 1, ny, lo, hi);
     m_lv = Field(nx, ny + 1, lo, vhi);
@@ -188,7 +205,9 @@ void Solver::face_pressure(double t) {
   }
 }
 
-// Helmholtz operators of Crank-Nicolson: (L - 2/(nu dt)) for u and for v.
+// Helmholtz operators of Crank-Nicolson: (L - 2/(nu dt)) for u and for v, solved exactly
+// (FastSolver, SlabSolver) or factored along the grid lines (helmholtz = "factored"; in the
+// same layout, the transform axis contiguous).
 void Solver::build_implicit(double dt) {
   const double sigma = 2.0 / (m_nu * dt);
   const Axis& T = m_grid.axis(m_t_axis);
@@ -197,6 +216,12 @@ void Solver::build_implicit(double dt) {
   for (int comp = 0; comp < 2; ++comp) {
     const Loc lt = comp == m_t_axis ? Loc::normal : Loc::tangential;
     const Loc ls = comp == m_t_axis ? Loc::tangential : Loc::normal;
+    if (m_cfg.factored_helmholtz) {
+      (comp == 0 ? m_fact_u : m_fact_v) = std::make_unique<FactoredSolver>(
+          tridiagonal_operator(T, lt, m_bnd, side_t), tridiagonal_operator(S, ls, m_bnd, side_s),
+          sigma);
+      continue;
+    }
     const Operator1D ot = make_operator(T, lt, true, m_bnd, side_t);
     const Operator1D os = make_operator(S, ls, false, m_bnd, side_s);
     if (m_dec.serial()) {
@@ -222,16 +247,22 @@ std::array<double, 2> Solver::body_acceleration(double t) const {
 }
 
 double* Solver::solve_data(int which) {
+  if (which < 2 && m_fact_u) return (which == 0 ? *m_fact_u : *m_fact_v).data();
   if (m_dec.serial()) return (which == 0 ? *m_helm_u : which == 1 ? *m_helm_v : *m_poisson).data();
   return (which == 0 ? *m_slab_u : which == 1 ? *m_slab_v : *m_slab_poisson).data();
 }
 
 int Solver::solve_nt(int which) const {
+  if (which < 2 && m_fact_u) return (which == 0 ? *m_fact_u : *m_fact_v).nt();
   if (m_dec.serial()) return (which == 0 ? *m_helm_u : which == 1 ? *m_helm_v : *m_poisson).nt();
   return (which == 0 ? *m_slab_u : which == 1 ? *m_slab_v : *m_slab_poisson).row_length();
 }
 
 std::size_t Solver::solve_size(int which) const {
+  if (which < 2 && m_fact_u) {
+    const FactoredSolver& f = which == 0 ? *m_fact_u : *m_fact_v;
+    return std::size_t(f.nt()) * f.ns();
+  }
   if (m_dec.serial()) {
     const FastSolver& f = which == 0 ? *m_helm_u : which == 1 ? *m_helm_v : *m_poisson;
     return std::size_t(f.nt()) * f.ns();
@@ -252,6 +283,7 @@ Solver::TransposeTraffic Solver::transpose_traffic() const {
 }
 
 void Solver::solve(int which) {
+  if (which < 2 && m_fact_u) return (which == 0 ? *m_fact_u : *m_fact_v).solve();
   if (m_dec.serial()) return (which == 0 ? *m_helm_u : which == 1 ? *m_helm_v : *m_poisson).solve();
   (which == 0 ? *m_slab_u : which == 1 ? *m_slab_v : *m_slab_poisson).solve();
 }

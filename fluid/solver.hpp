@@ -16,6 +16,7 @@
 #include "boundary.hpp"
 #include "config.hpp"
 #include "decomposition.hpp"
+#include "factored_solver.hpp"
 #include "fast_solver.hpp"
 #include "field.hpp"
 #include "grid.hpp"
@@ -206,6 +207,7 @@ class Solver {
   double m_begun_dt = 0;  // dt of the step begin_step() began
   std::unique_ptr<FastSolver> m_poisson, m_helm_u, m_helm_v;
   std::unique_ptr<SlabSolver> m_slab_poisson, m_slab_u, m_slab_v;  // on several ranks
+  std::unique_ptr<FactoredSolver> m_fact_u, m_fact_v;  // helmholtz = "factored"
   // Crank-Nicolson: the boundary increment of the step's solve, per component, in the Helmholtz
   // solver's layout (predictor_implicit), until its solve.
   std::array<std::vector<double>, 2> m_rhs;
