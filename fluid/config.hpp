@@ -78,7 +78,7 @@ struct Config {
   // lambda, but a moving body's coupling holds less: fluid/README.md).
   bool forcing_in_increment = false;  // fluid.implicit_forcing, default "after_solve"
   // Crank-Nicolson's Helmholtz solves: exact by transforms ("direct") or approximately factored
-  // along the grid lines ("factored", factored_solver.hpp: second order, no transform, one rank).
+  // along the grid lines ("factored", factored_solver.hpp: second order, no transform).
   bool factored_helmholtz = false;  // fluid.helmholtz
   // fluid.body_viscosity = "none": the fluid's viscous stress weighted by 1 − φ (φ the bodies'
   // volume fraction), so that bodies are purely elastic (body_viscosity.cpp); "kelvin-voigt"

@@ -2,6 +2,7 @@
 // direction (factored_solver.hpp).
 #include "factored_solver.hpp"
 
+#include <algorithm>
 #include <cstddef>
 
 #include "error.hpp"
@@ -100,69 +101,102 @@ void sweep_contiguous(double* x, std::size_t stride, const FactoredSolver::Line&
   }
 }
 
-// The lines along the other direction, x[c + cols j]: all columns at once (vectorised). The
-// forward elimination of row j, once rows up to j hold their final right-hand side, ...
-void eliminate_across(double* x, int cols, const FactoredSolver::Line& L, int j) {
-  double* xj = x + std::size_t(cols) * j;
-  const double ip = L.inv_piv[j];
-  if (j == 0) {
-    for (int c = 0; c < cols; ++c) xj[c] *= ip;
-    return;
-  }
-  const double* xm = xj - cols;
-  const double s = L.sub[j];
-  for (int c = 0; c < cols; ++c) xj[c] = (xj[c] - s * xm[c]) * ip;
-}
-
-// ... and the back substitution of all rows (with the periodic correction).
-void substitute_across(double* x, int cols, const FactoredSolver::Line& L, double* tmp) {
-  const int n = L.n;
-  const std::size_t w = cols;
-  for (int j = n - 2; j >= 0; --j) {
-    double* xj = x + w * j;
-    const double* xp = xj + w;
-    const double g = L.gamma[j];
-    for (int c = 0; c < cols; ++c) xj[c] -= g * xp[c];
-  }
-  if (!L.cyclic) return;
-  const double* last = x + w * (n - 1);
-  for (int c = 0; c < cols; ++c) tmp[c] = (x[c] + L.ratio * last[c]) / L.denom;
-  for (int j = 0; j < n; ++j) {
-    double* xj = x + w * j;
-    const double zj = L.z[j];
-    for (int c = 0; c < cols; ++c) xj[c] -= zj * tmp[c];
-  }
-}
-
 }  // namespace
 
 FactoredSolver::FactoredSolver(const Operator1D& f, const Operator1D& s, double sigma)
-    : m_f(make_line(f, sigma)), m_s(make_line(s, sigma)) {
+    : FactoredSolver(f, s, sigma, MPI_COMM_NULL, 0, s.n, 0) {}
+
+FactoredSolver::FactoredSolver(const Operator1D& f, const Operator1D& s, double sigma,
+                               MPI_Comm comm, int lo, int hi, int pad)
+    : m_f(make_line(f, sigma)), m_s(make_line(s, sigma)), m_sigma(sigma), m_comm(comm) {
   FSI_ASSERT(sigma > 0);
-  m_buf.assign(std::size_t(m_f.n) * m_s.n, 0.0);
+  FSI_ASSERT(lo <= hi && pad >= 0);
+  const int n = m_s.n;
+  m_k0 = std::max(lo, pad) - pad;
+  m_k1 = std::max(hi - pad, m_k0);
+  FSI_ASSERT(m_k1 <= n);
+  m_off = std::max(lo, pad) - lo;
+  m_buf.assign(std::size_t(m_f.n) * (hi - lo), 0.0);
   m_tmp.assign(m_f.n, 0.0);
-  m_sigma = sigma;
+  if (comm != MPI_COMM_NULL) {
+    int rank = 0;
+    MPI_Comm_rank(comm, &rank);
+    // The rows next to this rank's unknown rows belong to the neighbouring ranks (every rank
+    // holds at least one row).
+    if (m_k1 > m_k0 && m_k0 > 0) m_below = rank - 1;
+    if (m_k1 > m_k0 && m_k1 < n) m_above = rank + 1;
+    m_prev.assign(m_f.n, 0.0);
+    m_next.assign(m_f.n, 0.0);
+    m_ends.assign(2 * std::size_t(m_f.n), 0.0);
+  }
 }
 
 // -sigma (I - L_f / sigma)(I - L_s / sigma) x = b: the contiguous lines solve
 // (I - L_f / sigma) w = -b / sigma, then the other direction (I - L_s / sigma) x = w. Each block
 // of contiguous lines is eliminated along the other direction while still in cache, so that
-// only the back substitution takes a second pass over the array.
+// only the back substitution takes a second pass over the array. Along s, row k's forward step
+// is x_k = (x_k - l_k x_(k-1)) / p_k (x_0 / p_0), its back step x_k -= g_k x_(k+1).
 void FactoredSolver::solve() {
-  const int nf = m_f.n, ns = m_s.n;
+  const int nf = m_f.n, n = m_s.n, m = m_k1 - m_k0;
   const std::size_t w = nf;
   const double scale = -1.0 / m_sigma;
-  double* x = m_buf.data();
-  int j = 0;
-  for (; j + 8 <= ns; j += 8) {
-    sweep_contiguous<8>(x + w * j, w, m_f, scale);
-    for (int r = j; r < j + 8; ++r) eliminate_across(x, nf, m_s, r);
+  const Line& S = m_s;
+  double* x = m_buf.data() + w * m_off;
+  constexpr int kTag = 7301;
+  if (m_below != MPI_PROC_NULL)
+    MPI_Recv(m_prev.data(), nf, MPI_DOUBLE, m_below, kTag, m_comm, MPI_STATUS_IGNORE);
+  auto eliminate = [&](int q) {
+    const int k = m_k0 + q;
+    double* xj = x + w * q;
+    const double ip = S.inv_piv[k];
+    if (k == 0) {
+      for (int c = 0; c < nf; ++c) xj[c] *= ip;
+      return;
+    }
+    const double* xm = q == 0 ? m_prev.data() : xj - w;
+    const double l = S.sub[k];
+    for (int c = 0; c < nf; ++c) xj[c] = (xj[c] - l * xm[c]) * ip;
+  };
+  int q = 0;
+  for (; q + 8 <= m; q += 8) {
+    sweep_contiguous<8>(x + w * q, w, m_f, scale);
+    for (int r = q; r < q + 8; ++r) eliminate(r);
   }
-  for (; j < ns; ++j) {
-    sweep_contiguous<1>(x + w * j, w, m_f, scale);
-    eliminate_across(x, nf, m_s, j);
+  for (; q < m; ++q) {
+    sweep_contiguous<1>(x + w * q, w, m_f, scale);
+    eliminate(q);
   }
-  substitute_across(x, nf, m_s, m_tmp.data());
+  if (m_above != MPI_PROC_NULL) {
+    MPI_Send(x + w * (m - 1), nf, MPI_DOUBLE, m_above, kTag, m_comm);
+    MPI_Recv(m_next.data(), nf, MPI_DOUBLE, m_above, kTag + 1, m_comm, MPI_STATUS_IGNORE);
+  }
+  for (int r = m - 1; r >= 0; --r) {
+    const int k = m_k0 + r;
+    if (k == n - 1) continue;
+    double* xj = x + w * r;
+    const double* xp = r == m - 1 ? m_next.data() : xj + w;
+    const double g = S.gamma[k];
+    for (int c = 0; c < nf; ++c) xj[c] -= g * xp[c];
+  }
+  if (m_below != MPI_PROC_NULL) MPI_Send(x, nf, MPI_DOUBLE, m_below, kTag + 1, m_comm);
+  if (!S.cyclic) return;
+  // x -= (x_0 + ratio x_(n-1)) / denom z, x_0 and x_(n-1) from the ranks that hold them.
+  const double* first = x;
+  const double* last = m_k1 == n ? x + w * (n - 1 - m_k0) : nullptr;
+  if (m_comm != MPI_COMM_NULL) {
+    std::fill(m_ends.begin(), m_ends.end(), 0.0);
+    if (m_k0 == 0 && m > 0) std::copy(x, x + nf, m_ends.begin());
+    if (last && m > 0) std::copy(last, last + nf, m_ends.begin() + nf);
+    MPI_Allreduce(MPI_IN_PLACE, m_ends.data(), 2 * nf, MPI_DOUBLE, MPI_SUM, m_comm);
+    first = m_ends.data();
+    last = m_ends.data() + nf;
+  }
+  for (int c = 0; c < nf; ++c) m_tmp[c] = (first[c] + S.ratio * last[c]) / S.denom;
+  for (int r = 0; r < m; ++r) {
+    double* xj = x + w * r;
+    const double zj = S.z[m_k0 + r];
+    for (int c = 0; c < nf; ++c) xj[c] -= zj * m_tmp[c];
+  }
 }
 
 }  // namespace fluid

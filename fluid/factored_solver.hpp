@@ -11,7 +11,15 @@
 // Stability: for a Fourier mode with a = -theta lambda_f >= 0, b = -theta lambda_s >= 0 the
 // increment-form step u~ = u^n + F^(-1) 2 theta L u^n multiplies it by
 //   1 - 2 (a + b) / ((1 + a)(1 + b)) = (1 - a)(1 - b) / ((1 + a)(1 + b)),  |.| <= 1 at any dt.
+//
+// On several ranks (the fluid's slabs of rows, x fastest): the lines along x are whole on each
+// rank; the lines along y are solved in a pipeline, each rank eliminating its rows once the rank
+// below has sent its last eliminated row, and substituting back once the rank above has sent
+// its first solved row (one row of x unknowns per message and direction). Every operation on a
+// value is that of the one-rank solve, so the result is bit-identical.
 #pragma once
+
+#include <mpi.h>
 
 #include <vector>
 
@@ -25,10 +33,16 @@ class FactoredSolver {
   // (a, b, c: the boundary rows folded in) or Closure::periodic with rows whose a[0] and c[n-1]
   // are the wrap-around coefficients. sigma = 1 / theta = 2 / (nu dt).
   FactoredSolver(const Operator1D& f, const Operator1D& s, double sigma);
+  // On the slabs of rows: f along x, s along y, whose unknowns are the global rows [pad, rows);
+  // this rank holds the rows [lo, hi) of `comm` (a padded row is returned as zero).
+  FactoredSolver(const Operator1D& f, const Operator1D& s, double sigma, MPI_Comm comm, int lo,
+                 int hi, int pad);
 
   int nt() const { return m_f.n; }
-  int ns() const { return m_s.n; }
-  double* data() { return m_buf.data(); }  // right-hand side in, solution out
+  int ns() const { return m_s.n; }  // the s direction's unknowns (all ranks)
+  // Right-hand side in, solution out: one rank, nt() x ns(); on slabs, the rows [lo, hi).
+  double* data() { return m_buf.data(); }
+  std::size_t size() const { return m_buf.size(); }
   // FastSolver's convention: data() holds b of (L - sigma) x = b, here with L - sigma replaced by
   // -sigma (I - L_f / sigma)(I - L_s / sigma); solved in place.
   void solve();
@@ -49,6 +63,12 @@ class FactoredSolver {
   Line m_f, m_s;
   double m_sigma = 0;
   std::vector<double> m_buf, m_tmp;
+  // The rows of s this rank solves: [m_k0, m_k1), from row m_off of the buffer; the ranks below
+  // and above (MPI_PROC_NULL at the ends, or when no unknown row borders this rank's).
+  int m_k0 = 0, m_k1 = 0, m_off = 0;
+  MPI_Comm m_comm = MPI_COMM_NULL;
+  int m_below = MPI_PROC_NULL, m_above = MPI_PROC_NULL;
+  std::vector<double> m_prev, m_next, m_ends;
 };
 
 }  // namespace fluid

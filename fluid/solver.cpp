@@ -157,11 +157,6 @@ Solver::Solver(const Config& c, double dt, MPI_Comm comm)
     m_un = Field(nx + 1, ny, lo, hi);
     m_vn = Field(nx, ny + 1, lo, vhi);
   }
-  if (c.implicit && c.factored_helmholtz && !m_dec.serial())
-    throw fsi::InputError(fmt::format(
-        "fluid.helmholtz = \"factored\" needs the fluid on one rank (its sweeps run along both "
-        "grid directions); set ranks = 1 or helmholtz = \"direct\" (in {})",
-        c.source));
   if (c.implicit) {
     m_lu = Field(nx + 1, ny, lo, hi);
     m_lv = Field(nx, ny + 1, lo, vhi);
@@ -217,9 +212,20 @@ void Solver::build_implicit(double dt) {
     const Loc lt = comp == m_t_axis ? Loc::normal : Loc::tangential;
     const Loc ls = comp == m_t_axis ? Loc::tangential : Loc::normal;
     if (m_cfg.factored_helmholtz) {
-      (comp == 0 ? m_fact_u : m_fact_v) = std::make_unique<FactoredSolver>(
-          tridiagonal_operator(T, lt, m_bnd, side_t), tridiagonal_operator(S, ls, m_bnd, side_s),
-          sigma);
+      auto& f = comp == 0 ? m_fact_u : m_fact_v;
+      if (m_dec.serial()) {
+        f = std::make_unique<FactoredSolver>(tridiagonal_operator(T, lt, m_bnd, side_t),
+                                             tridiagonal_operator(S, ls, m_bnd, side_s), sigma);
+      } else {
+        // The slabs' layout: x contiguous whatever the transform axis; a padded row 0 for the v
+        // faces between walls.
+        const Loc lx = comp == 0 ? Loc::normal : Loc::tangential;
+        const Loc ly = comp == 0 ? Loc::tangential : Loc::normal;
+        f = std::make_unique<FactoredSolver>(
+            tridiagonal_operator(m_grid.x(), lx, m_bnd, 0),
+            tridiagonal_operator(m_grid.y(), ly, m_bnd, 2), sigma, m_dec.comm(), m_dec.lo(),
+            m_dec.hi(), comp == 1 ? m_j0 : 0);
+      }
       continue;
     }
     const Operator1D ot = make_operator(T, lt, true, m_bnd, side_t);
@@ -259,10 +265,7 @@ int Solver::solve_nt(int which) const {
 }
 
 std::size_t Solver::solve_size(int which) const {
-  if (which < 2 && m_fact_u) {
-    const FactoredSolver& f = which == 0 ? *m_fact_u : *m_fact_v;
-    return std::size_t(f.nt()) * f.ns();
-  }
+  if (which < 2 && m_fact_u) return (which == 0 ? *m_fact_u : *m_fact_v).size();
   if (m_dec.serial()) {
     const FastSolver& f = which == 0 ? *m_helm_u : which == 1 ? *m_helm_v : *m_poisson;
     return std::size_t(f.nt()) * f.ns();
