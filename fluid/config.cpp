@@ -294,7 +294,7 @@ Config read_config(const fsi::SceneTable& f, double dt) {
                          c.forcing_in_increment ? "increment" : "after_solve"));
   }
   if (f.has("helmholtz")) {
-    c.factored_helmholtz = f.choice("helmholtz", {"direct", "factored"}, "direct") == "factored";
+    c.factored_helmholtz = f.choice("helmholtz", {"factored", "direct"}, "factored") == "factored";
     if (!c.implicit)
       f.fail("helmholtz", fmt::format("= \"{}\" applies to Crank-Nicolson only: set diffusion = "
                                       "\"implicit\" or remove the key",

@@ -77,9 +77,10 @@ struct Config {
   // on the covered faces after it ("increment", predictor.cpp: the explicit scheme's wall at any
   // lambda, but a moving body's coupling holds less: fluid/README.md).
   bool forcing_in_increment = false;  // fluid.implicit_forcing, default "after_solve"
-  // Crank-Nicolson's Helmholtz solves: exact by transforms ("direct") or approximately factored
-  // along the grid lines ("factored", factored_solver.hpp: second order, no transform).
-  bool factored_helmholtz = false;  // fluid.helmholtz
+  // Crank-Nicolson's Helmholtz solves: approximately factored along the grid lines ("factored",
+  // the default; factored_solver.hpp: second order, no transform) or exact by transforms
+  // ("direct").
+  bool factored_helmholtz = true;  // fluid.helmholtz
   // fluid.body_viscosity = "none": the fluid's viscous stress weighted by 1 − φ (φ the bodies'
   // volume fraction), so that bodies are purely elastic (body_viscosity.cpp); "kelvin-voigt"
   // (the default): the fluid's viscosity everywhere, bodies are Kelvin-Voigt with μ_s = μ_f.

@@ -124,12 +124,12 @@ TEST_CASE("implicit_forcing: read with Crank-Nicolson, refused without it or unk
                         Contains("Crank-Nicolson only"));
 }
 
-TEST_CASE("helmholtz: direct by default, factored with Crank-Nicolson, refused otherwise",
+TEST_CASE("helmholtz: factored by default, direct with Crank-Nicolson, refused otherwise",
           "[fluid][config][implicit]") {
   const std::string cn = replace(kGood, "viscosity = 0.01", "viscosity = 0.01\ndiffusion = \"implicit\"");
-  CHECK_FALSE(read(cn).factored_helmholtz);
-  CHECK(read(replace(cn, "viscosity = 0.01", "viscosity = 0.01\nhelmholtz = \"factored\""))
-            .factored_helmholtz);
+  CHECK(read(cn).factored_helmholtz);
+  CHECK_FALSE(read(replace(cn, "viscosity = 0.01", "viscosity = 0.01\nhelmholtz = \"direct\""))
+                  .factored_helmholtz);
   CHECK_THROWS_WITH(read(replace(cn, "viscosity = 0.01", "viscosity = 0.01\nhelmholtz = \"adi\"")),
                     Contains("helmholtz") && Contains("adi"));
   CHECK_THROWS_WITH(
