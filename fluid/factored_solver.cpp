@@ -142,9 +142,8 @@ void FactoredSolver::solve() {
   const double scale = -1.0 / m_sigma;
   const Line& S = m_s;
   double* x = m_buf.data() + w * m_off;
-  constexpr int kTag = 7301;
-  if (m_below != MPI_PROC_NULL)
-    MPI_Recv(m_prev.data(), nf, MPI_DOUBLE, m_below, kTag, m_comm, MPI_STATUS_IGNORE);
+  // Tags of their own (the fluid's halo exchange uses others on the same communicator).
+  constexpr int kTagUp = 7411, kTagDown = 7412;
   auto eliminate = [&](int q) {
     const int k = m_k0 + q;
     double* xj = x + w * q;
@@ -157,18 +156,26 @@ void FactoredSolver::solve() {
     const double l = S.sub[k];
     for (int c = 0; c < nf; ++c) xj[c] = (xj[c] - l * xm[c]) * ip;
   };
+  // A rank with a rank below sweeps all its x lines first, so that every rank does its larger
+  // part at once and only the elimination along y waits for the row from below.
+  const bool wait = m_below != MPI_PROC_NULL;
   int q = 0;
   for (; q + 8 <= m; q += 8) {
     sweep_contiguous<8>(x + w * q, w, m_f, scale);
-    for (int r = q; r < q + 8; ++r) eliminate(r);
+    if (!wait)
+      for (int r = q; r < q + 8; ++r) eliminate(r);
   }
   for (; q < m; ++q) {
     sweep_contiguous<1>(x + w * q, w, m_f, scale);
-    eliminate(q);
+    if (!wait) eliminate(q);
+  }
+  if (wait) {
+    MPI_Recv(m_prev.data(), nf, MPI_DOUBLE, m_below, kTagUp, m_comm, MPI_STATUS_IGNORE);
+    for (int r = 0; r < m; ++r) eliminate(r);
   }
   if (m_above != MPI_PROC_NULL) {
-    MPI_Send(x + w * (m - 1), nf, MPI_DOUBLE, m_above, kTag, m_comm);
-    MPI_Recv(m_next.data(), nf, MPI_DOUBLE, m_above, kTag + 1, m_comm, MPI_STATUS_IGNORE);
+    MPI_Send(x + w * (m - 1), nf, MPI_DOUBLE, m_above, kTagUp, m_comm);
+    MPI_Recv(m_next.data(), nf, MPI_DOUBLE, m_above, kTagDown, m_comm, MPI_STATUS_IGNORE);
   }
   for (int r = m - 1; r >= 0; --r) {
     const int k = m_k0 + r;
@@ -178,7 +185,7 @@ void FactoredSolver::solve() {
     const double g = S.gamma[k];
     for (int c = 0; c < nf; ++c) xj[c] -= g * xp[c];
   }
-  if (m_below != MPI_PROC_NULL) MPI_Send(x, nf, MPI_DOUBLE, m_below, kTag + 1, m_comm);
+  if (m_below != MPI_PROC_NULL) MPI_Send(x, nf, MPI_DOUBLE, m_below, kTagDown, m_comm);
   if (!S.cyclic) return;
   // x -= (x_0 + ratio x_(n-1)) / denom z, x_0 and x_(n-1) from the ranks that hold them.
   const double* first = x;

@@ -13,10 +13,11 @@
 //   1 - 2 (a + b) / ((1 + a)(1 + b)) = (1 - a)(1 - b) / ((1 + a)(1 + b)),  |.| <= 1 at any dt.
 //
 // On several ranks (the fluid's slabs of rows, x fastest): the lines along x are whole on each
-// rank; the lines along y are solved in a pipeline, each rank eliminating its rows once the rank
-// below has sent its last eliminated row, and substituting back once the rank above has sent
-// its first solved row (one row of x unknowns per message and direction). Every operation on a
-// value is that of the one-rank solve, so the result is bit-identical.
+// rank and swept by all ranks at once; the lines along y are solved rank after rank, each
+// eliminating its rows once the rank below has sent its last eliminated row, and substituting
+// back once the rank above has sent its first solved row (one row of x unknowns per message and
+// direction): that part, about a third of the solve, does not run in parallel. Every operation
+// on a value is that of the one-rank solve, so the result is bit-identical.
 #pragma once
 
 #include <mpi.h>

@@ -7,7 +7,9 @@ its observed order, wall times, plots. `--short`: CFD1 on the two coarser grids 
 `--bands`: CFD1 and CFD2 on 750 columns and 123 rows, 72 of them in a y band over the cylinder
 and the bar (fluid.grid.y_band), against the uniform grids (bands.json; about 12 min).
 `--reuse`: keep a run whose folder in FSI_OUT has a summary.json from the identical scene text.
-`--helmholtz direct|factored`: fluid.helmholtz in the scenes (else the default, factored).
+`--helmholtz direct|factored`: fluid.helmholtz in the scenes (factored by default: the key is
+always written, so that --reuse never takes a run of the direct solve for one of the factored);
+runs with the direct solve are named *-direct.
 Environment (set by `./fsi validate`): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN."""
 import json
 import os
@@ -30,7 +32,7 @@ _p.add_argument("--dt-study", action="store_true", help="the forces against the 
 _p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
 _p.add_argument("--bands", action="store_true",
                 help="CFD1 and CFD2 on 750 x 123 with 72 rows in a y band around the body")
-_p.add_argument("--helmholtz", choices=["direct", "factored"],
+_p.add_argument("--helmholtz", choices=["direct", "factored"], default="factored",
                 help="fluid.helmholtz of the scenes (Crank-Nicolson's Helmholtz solves)")
 ARGS = _p.parse_args()
 SHORT, REUSE = ARGS.short, ARGS.reuse
@@ -100,7 +102,7 @@ def scene_text(case, n, dt=None, band=None, name=None):
             line = replace.pop(key)
         elif key == "mesh":
             line = f'mesh = "{os.path.join(HERE, "obstacle.geo")}"'
-        elif key == "diffusion" and ARGS.helmholtz:
+        elif key == "diffusion":
             line += f'\nhelmholtz = "{ARGS.helmholtz}"'
         lines.append(line)
     assert not replace, f"scene {case}.toml lacks keys {list(replace)}"
@@ -108,8 +110,9 @@ def scene_text(case, n, dt=None, band=None, name=None):
 
 
 def run(name, text):
-    """Run fluid + solid + coupler on the scene into OUT/name; (folder, wall s)."""
-    r = job.run(name, text, reuse=REUSE)
+    """Run fluid + solid + coupler on the scene into OUT/name (OUT/name-direct with the direct
+    Helmholtz solves); (folder, wall s)."""
+    r = job.run(name + ("-direct" if ARGS.helmholtz == "direct" else ""), text, reuse=REUSE)
     return r.folder, r.wall
 
 

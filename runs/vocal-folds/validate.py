@@ -20,7 +20,8 @@ contact between them.
 --material neo-hookean: the folds' cover and body neo-Hookean with the same small-strain E and nu
   (the paper: St.Venant-Kirchhoff, which loses its stiffness under strong compression; README),
   every output under OUT/neo-hookean. --clearances H,H,...: the sweep's velocity-inflow runs at
-  these clearances only (and no pressure-inlet run).
+  these clearances only (and no pressure-inlet run). --dt DT: the coupled runs' time step (the
+  paper's 5e-5 by default), every output under OUT/dt-DT.
 With no option (`./fsi validate vocal-folds`): --modes, --short and --sweep."""
 import fcntl
 import json
@@ -63,6 +64,8 @@ P.add_argument("--material", choices=("saint-venant-kirchhoff", "neo-hookean"),
                default="saint-venant-kirchhoff", help="the folds' material (the paper's by default)")
 P.add_argument("--clearances", type=lambda s: [float(v) for v in s.split(",")], default=None,
                help="--sweep: only these clearances, velocity inflow")
+P.add_argument("--dt", type=cli.positive, default=None,
+               help="the coupled runs' time step (default: the scene's, the paper's 5e-5)")
 ARGS = P.parse_args()
 if not (ARGS.modes or ARGS.short or ARGS.run is not None or ARGS.sweep):
     ARGS.modes = ARGS.short = ARGS.sweep = True
@@ -71,6 +74,9 @@ if ARGS.sweep:
 OUT = job.out_dir("vocal-folds")
 if ARGS.material != "saint-venant-kirchhoff":
     OUT = job.OUT = os.path.join(OUT, ARGS.material)
+    os.makedirs(OUT, exist_ok=True)
+if ARGS.dt is not None:
+    OUT = job.OUT = os.path.join(OUT, f"dt-{ARGS.dt:g}")
     os.makedirs(OUT, exist_ok=True)
 HERE = os.path.dirname(os.path.abspath(__file__))
 GEO = os.path.join(HERE, "fold.geo")
@@ -90,6 +96,8 @@ def scene(h, grid="paper", t_end=10.0, interval=0.05, ramp=None, fluid=True, mod
     text = text.replace("cells = [560, 102]", f"cells = [{nx}, {ny}]")
     text = text.replace("size = [5.6, 1.02]", f"size = [5.6, {1 + h!r}]")
     text = text.replace("cells = 40\n", f"cells = {sponge}\n").replace("ratio = 1.05", f"ratio = {ratio}")
+    if ARGS.dt is not None and fluid:
+        text = text.replace("dt = 5e-5", f"dt = {ARGS.dt!r}")
     text = text.replace("t_end = 10.0", f"t_end = {t_end!r}").replace("interval = 0.05", f"interval = {interval!r}")
     if p_sub is not None:
         # The physical alternative at a closed glottis: the subglottal pressure is given, the

@@ -135,6 +135,16 @@ TEST_CASE("helmholtz: factored by default, direct with Crank-Nicolson, refused o
   CHECK_THROWS_WITH(
       read(replace(kGood, "viscosity = 0.01", "viscosity = 0.01\nhelmholtz = \"factored\"")),
       Contains("helmholtz") && Contains("factored") && Contains("Crank-Nicolson only"));
+  // Walls across the transform direction (x): the direct solve holds for nu dt / h^2 < 2 only
+  // (h = 1/16, nu = 0.01: dt < 0.78), the factored one at any dt.
+  std::string walls = replace(replace(cn, "left = { type = \"periodic\" }", "left = { type = \"wall\" }"),
+                              "right = { type = \"periodic\" }", "right = { type = \"wall\" }");
+  CHECK_NOTHROW(read(walls, 1.0));
+  CHECK_THROWS_WITH(
+      read(replace(walls, "viscosity = 0.01", "viscosity = 0.01\nhelmholtz = \"direct\""), 1.0),
+      Contains("time.dt = 1") && Contains("nu dt / h^2 < 2"));
+  CHECK_NOTHROW(
+      read(replace(walls, "viscosity = 0.01", "viscosity = 0.01\nhelmholtz = \"direct\""), 0.5));
 }
 
 TEST_CASE("body_viscosity: kelvin-voigt by default, none, refused when unknown",
