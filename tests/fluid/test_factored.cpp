@@ -1,13 +1,11 @@
 // The approximately factored Crank-Nicolson solve (helmholtz = "factored"): exact inversion of
-// its factored operator, the exact discrete steady states, second order in time.
+// its factored operator (its steady states: test_core.cpp; second order in time: test_time.cpp).
 #include <catch2/catch.hpp>
 
 #include <cmath>
-#include <numbers>
 #include <random>
 
 #include "factored_solver.hpp"
-#include "solver.hpp"
 
 using namespace fluid;
 
@@ -55,20 +53,6 @@ std::vector<double> apply(const Operator1D& op, double sigma, const std::vector<
   return y;
 }
 
-Config channel(int nx, int ny, BcType x_bc, BcType y_bc) {
-  Config c;
-  c.density = 1;
-  c.viscosity = 1;
-  c.x = {nx, 2.0, 0.0};
-  c.y = {ny, 1.0, 0.0};
-  c.bc[left].type = c.bc[right].type = x_bc;
-  c.bc[bottom].type = c.bc[top].type = y_bc;
-  c.cfl_max = 1e9;
-  c.implicit = true;
-  c.factored_helmholtz = true;
-  return c;
-}
-
 }  // namespace
 
 TEST_CASE("factored solve inverts its factored operator exactly", "[fluid][factored]") {
@@ -93,36 +77,4 @@ TEST_CASE("factored solve inverts its factored operator exactly", "[fluid][facto
       INFO("periodic f " << pf << ", s " << ps << ": max error " << err);
       CHECK(err < 1e-13);
     }
-}
-
-TEST_CASE("factored Crank-Nicolson reaches the exact parabola at any diffusion number",
-          "[fluid][factored]") {
-  // Plane Poiseuille flow along x (walls in y, the uniform and stretched cases) and along y (walls
-  // at x = 0, 2, across the contiguous direction, where the direct solve is limited to
-  // nu dt / h^2 < 2), at nu dt / h^2 = 5.
-  for (int variant = 0; variant < 3; ++variant) {
-    Config c = variant < 2 ? channel(8, 16, BcType::periodic, BcType::wall)
-                           : channel(16, 8, BcType::wall, BcType::periodic);
-    if (variant == 1) c.y.tanh_beta = 1.2;
-    const int a = variant < 2 ? 0 : 1;
-    c.body[a] = 2.0;
-    const double h = variant < 2 ? 1.0 / 16 : 2.0 / 16;
-    const double dt = 5 * h * h;
-    Solver s(c, dt);
-    set_initial(s);
-    for (long k = 0; k < std::lround(20.0 / dt); ++k) s.step(dt);
-    double err = 0;
-    for (int j = 0; j < s.grid().ny(); ++j)
-      for (int i = 0; i < s.grid().nx(); ++i) {
-        if (variant < 2) {
-          const double y = s.grid().y().centre(j);
-          err = std::max(err, std::abs(s.u()(i, j) - y * (1 - y)));
-        } else {
-          const double x = s.grid().x().centre(i);
-          err = std::max(err, std::abs(s.v()(i, j) - x * (2 - x)));
-        }
-      }
-    INFO("variant " << variant << " max error " << err);
-    CHECK(err < 1e-10);
-  }
 }
