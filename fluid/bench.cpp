@@ -130,9 +130,10 @@ int main(int argc, char** argv) {
   fmt::print("notes: change | predicted | measured\n");
   fmt::print("  Crank-Nicolson's Helmholtz solves factored along the grid lines (was: FFTW + Thomas, "
              "749 points in the u solve) | two solves 3.4 -> 0.6 Poisson floors, step 5.3 -> 2.9 | "
-             "step/floor 5.20 -> 2.99 (750x123), 5.34 -> 3.14 (1500x246), same run\n");
+             "step/floor 5.20 -> 2.99 and 5.26 -> 2.76 (750x123), 5.34 -> 3.14 and 5.33 -> 2.98 (1500x246), "
+             "two runs\n");
   fmt::print("  its x lines 8 at a time, one multiply-add per step of each chain; the y elimination "
-             "while the rows are in cache | -30 %% per solve | 0.33 -> 0.20-0.24 ms (749 x 123)\n");
+             "while the rows are in cache | -30 % per solve | 0.33 -> 0.20-0.24 ms (749 x 123)\n");
   std::ofstream(out) << j.dump(2) << "\n";
   fmt::print("written {}\n", out);
   return 0;
