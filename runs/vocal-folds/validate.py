@@ -21,7 +21,8 @@ contact between them.
   (the paper: St.Venant-Kirchhoff, which loses its stiffness under strong compression; README),
   every output under OUT/neo-hookean. --clearances H,H,...: the sweep's velocity-inflow runs at
   these clearances only (and no pressure-inlet run). --dt DT: the coupled runs' time step (the
-  paper's 5e-5 by default), every output under OUT/dt-DT.
+  paper's 5e-5 by default), every output under OUT/dt-DT. --wall-planes: each fold kept on its
+  side of its wall by a rigid contact plane ([[solid.plane]]), every output under OUT/planes.
 With no option (`./fsi validate vocal-folds`): --modes, --short and --sweep."""
 import fcntl
 import json
@@ -64,6 +65,8 @@ P.add_argument("--material", choices=("saint-venant-kirchhoff", "neo-hookean"),
                default="saint-venant-kirchhoff", help="the folds' material (the paper's by default)")
 P.add_argument("--clearances", type=lambda s: [float(v) for v in s.split(",")], default=None,
                help="--sweep: only these clearances, velocity inflow")
+P.add_argument("--wall-planes", action="store_true",
+               help="a rigid contact plane at each wall, for the fold fixed on it")
 P.add_argument("--dt", type=cli.positive, default=None,
                help="the coupled runs' time step (default: the scene's, the paper's 5e-5)")
 ARGS = P.parse_args()
@@ -77,6 +80,9 @@ if ARGS.material != "saint-venant-kirchhoff":
     os.makedirs(OUT, exist_ok=True)
 if ARGS.dt is not None:
     OUT = job.OUT = os.path.join(OUT, f"dt-{ARGS.dt:g}")
+    os.makedirs(OUT, exist_ok=True)
+if ARGS.wall_planes:
+    OUT = job.OUT = os.path.join(OUT, "planes")
     os.makedirs(OUT, exist_ok=True)
 HERE = os.path.dirname(os.path.abspath(__file__))
 GEO = os.path.join(HERE, "fold.geo")
@@ -96,6 +102,21 @@ def scene(h, grid="paper", t_end=10.0, interval=0.05, ramp=None, fluid=True, mod
     text = text.replace("cells = [560, 102]", f"cells = [{nx}, {ny}]")
     text = text.replace("size = [5.6, 1.02]", f"size = [5.6, {1 + h!r}]")
     text = text.replace("cells = 40\n", f"cells = {sponge}\n").replace("ratio = 1.05", f"ratio = {ratio}")
+    if ARGS.wall_planes:
+        # A fold pressed against its own wall stays inside the channel (the model has no other
+        # fold-wall contact: a free node beyond the wall stops the coupler).
+        text = text.replace("[coupler]\n", f"""[[solid.plane]]
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+bodies = ["lower"]
+
+[[solid.plane]]
+point = [0.0, {1 + h!r}]
+normal = [0.0, -1.0]
+bodies = ["upper"]
+
+[coupler]
+""", 1)
     if ARGS.dt is not None and fluid:
         text = text.replace("dt = 5e-5", f"dt = {ARGS.dt!r}")
     text = text.replace("t_end = 10.0", f"t_end = {t_end!r}").replace("interval = 0.05", f"interval = {interval!r}")
