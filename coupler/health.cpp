@@ -16,15 +16,22 @@ constexpr double kCoarseElements = 4;
 constexpr double kFineElements = 8;
 // Fiber markers farther apart than this many grid spacings let the fluid leak between them.
 constexpr double kMarkerGap = 2;
+// A node beyond a non-periodic boundary by less than this fraction of the domain is on it.
+constexpr double kRoundOff = 1e-10;
 
 }  // namespace
 
 // The non-periodic boundary a point (x, y) is beyond, or nullptr when it is inside the domain.
+// A node held on a wall (by a contact plane there, or a fixed node of the mesh) may sit a
+// round-off beyond it, y = -1e-17 against a wall at 0: forgiven up to kRoundOff of the domain's
+// extent in that direction. Clipping drops what lies outside the cells, here nothing to speak of.
 const char* Coupler::outside(double x, double y) const {
-  if (!m_grid.periodic_x && x < m_grid.x_face.front()) return "left";
-  if (!m_grid.periodic_x && x > m_grid.x_face.back()) return "right";
-  if (!m_grid.periodic_y && y < m_grid.y_face.front()) return "bottom";
-  if (!m_grid.periodic_y && y > m_grid.y_face.back()) return "top";
+  const double tx = kRoundOff * (m_grid.x_face.back() - m_grid.x_face.front());
+  const double ty = kRoundOff * (m_grid.y_face.back() - m_grid.y_face.front());
+  if (!m_grid.periodic_x && x < m_grid.x_face.front() - tx) return "left";
+  if (!m_grid.periodic_x && x > m_grid.x_face.back() + tx) return "right";
+  if (!m_grid.periodic_y && y < m_grid.y_face.front() - ty) return "bottom";
+  if (!m_grid.periodic_y && y > m_grid.y_face.back() + ty) return "top";
   return nullptr;
 }
 
