@@ -342,11 +342,19 @@ Config read_config(const fsi::SceneTable& s, double fluid_density) {
     ContactPair p;
     p.slave = body_named(t, "bodies", names[0], c.model.bodies);
     p.master = body_named(t, "bodies", names[1], c.model.bodies);
-    if (p.slave == p.master) t.fail("bodies", "must name two different bodies");
+    // The same body twice: its surface against its own far parts (self-contact).
+    if (p.slave == p.master) {
+      if (c.model.bodies[p.slave].kind != BodyKind::elastic)
+        t.fail("bodies", fmt::format("names body \"{}\" twice (self-contact), which is rigid: "
+                                     "only an elastic body can touch itself",
+                                     names[0]));
+      if (t.has("two_way"))
+        t.fail("two_way", "has no meaning for a body against itself (self-contact): remove it");
+    }
     if (c.model.bodies[p.slave].kind == BodyKind::rigid &&
         c.model.bodies[p.master].kind == BodyKind::rigid)
       t.fail("bodies", "names two rigid bodies: one of them must be elastic");
-    p.two_way = t.boolean("two_way", true);
+    p.two_way = p.slave != p.master && t.boolean("two_way", true);
     // A rigid body only ever provides the surface.
     if (c.model.bodies[p.slave].kind == BodyKind::rigid) std::swap(p.slave, p.master);
     t.finish();

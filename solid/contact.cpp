@@ -18,6 +18,17 @@ constexpr double kVertexDistance = 1e-9;
 // How far (relative to its length) a slot's last edge is extended before the slot moves on to
 // the neighbouring edge or vertex: far above round-off of positions, far below a step's motion.
 constexpr double kKeepEdge = 1e-6;
+// Self-contact: a node never touches the surface edges nearer to it than this many of the
+// body's longest surface edges in the reference configuration (its own neighbourhood, and the
+// other side of a part thinner than that).
+constexpr double kSelfNear = 3;
+
+// Distance from p to the segment a-b.
+double segment_distance(double px, double py, double ax, double ay, double bx, double by) {
+  const double ex = bx - ax, ey = by - ay;
+  const double xi = std::clamp(((px - ax) * ex + (py - ay) * ey) / (ex * ex + ey * ey), 0.0, 1.0);
+  return std::hypot(ax + xi * ex - px, ay + xi * ey - py);
+}
 
 }  // namespace
 
@@ -83,7 +94,10 @@ void ContactSet::setup(const std::vector<const Mesh*>& meshes, const std::vector
   };
   for (const auto& p : pairs) {
     add(p.slave, p.master);
-    if (p.two_way) add(p.master, p.slave);
+    if (p.slave == p.master)
+      setup_self(m_surfaces[p.slave]);
+    else if (p.two_way)
+      add(p.master, p.slave);
   }
   for (std::size_t k = 0; k < planes.size(); ++k)
     for (int b : planes[k].bodies) {
@@ -95,6 +109,26 @@ void ContactSet::setup(const std::vector<const Mesh*>& meshes, const std::vector
         c.plane = static_cast<int>(k);
         m_slots.push_back(c);
       }
+    }
+}
+
+void ContactSet::setup_self(Surface& s) const {
+  const Mesh& m = *s.mesh;
+  const auto& X = m.x;
+  double longest = 0;
+  for (const auto& e : m.surface)
+    longest = std::max(longest, std::hypot(X[2 * e[1]] - X[2 * e[0]], X[2 * e[1] + 1] - X[2 * e[0] + 1]));
+  const double near = kSelfNear * longest;
+  s.self_edges.assign(m.num_nodes(), {});
+  s.vertex_edges.assign(m.num_nodes(), {});
+  for (std::size_t k = 0; k < m.surface.size(); ++k)
+    for (int v : m.surface[k]) s.vertex_edges[v].push_back(static_cast<int>(k));
+  for (int n : s.nodes)
+    for (std::size_t k = 0; k < m.surface.size(); ++k) {
+      const auto& e = m.surface[k];
+      if (segment_distance(X[2 * n], X[2 * n + 1], X[2 * e[0]], X[2 * e[0] + 1], X[2 * e[1]],
+                           X[2 * e[1] + 1]) > near)
+        s.self_edges[n].push_back(static_cast<int>(k));
     }
 }
 
@@ -129,6 +163,7 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
     s.xi = 0;
     return;
   }
+  if (s.master_body == s.slave_body) return detect_self(s, *x[s.slave_body], reach);
   const auto& box = boxes[s.master_body];
   const double dx = std::max({box[0] - px, 0.0, px - box[2]});
   const double dy = std::max({box[1] - py, 0.0, py - box[3]});
@@ -217,6 +252,88 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
   s.xi = best_xi;
   s.normal = {ey / le, -ex / le};
   s.gap = (px - ax - best_xi * ex) * s.normal[0] + (py - ay - best_xi * ey) * s.normal[1];
+}
+
+// Self-contact, a node of a body against its own surface. Three differences from two bodies:
+// - A surface is at distance 0 of itself near every node: a node looks only at the edges
+//   farther than kSelfNear longest surface edges from it in the reference configuration
+//   (Surface::self_edges). Parts nearer than that in the reference never touch.
+// - Inside is not decided by ray casting (the node lies on the very surface it would cast
+//   against) but by the edge's normal; at a vertex v by the sum of the two edges' normals there,
+//   n_v (the pseudo-normal: when v is the closest point of the surface, (p - v) . n_v > 0
+//   exactly outside, at a convex and a concave vertex alike; Baerentzen & Aanaes 2005).
+// - A feature with the node behind it by more than `reach` is the body's other side, not a
+//   contact: it is passed over (the slot's own active edge excepted). So self-penetration
+//   deeper than `reach` in one step would not be seen; the step moves nodes far less.
+// Features: the closest edge (within the kKeepEdge rule of detect_slot) or vertex among those.
+void ContactSet::detect_self(ContactSlot& s, const std::vector<double>& x, double reach) const {
+  const Surface& surf = m_surfaces[s.slave_body];
+  const Mesh& mesh = *surf.mesh;
+  const double px = x[2 * s.slave_node], py = x[2 * s.slave_node + 1];
+  auto edge_normal = [&](int k) {
+    const auto& e = mesh.surface[k];
+    const double ex = x[2 * e[1]] - x[2 * e[0]], ey = x[2 * e[1] + 1] - x[2 * e[0] + 1];
+    const double l = std::hypot(ex, ey);
+    return Vec2{ey / l, -ex / l};
+  };
+  double best = std::numeric_limits<double>::max();
+  int best_edge = -1;
+  double best_xi = 0, best_gap = 0;
+  Vec2 best_normal{0, 0};
+  bool best_vertex = false;
+  for (int k : surf.self_edges[s.slave_node]) {
+    const auto& e = mesh.surface[k];
+    const double ax = x[2 * e[0]], ay = x[2 * e[0] + 1];
+    const double ex = x[2 * e[1]] - ax, ey = x[2 * e[1] + 1] - ay;
+    const double l2 = ex * ex + ey * ey;
+    const double xi_line = ((px - ax) * ex + (py - ay) * ey) / l2;
+    // The slot's last edge, extended by kKeepEdge of its length (detect_slot's rule).
+    const bool kept = e[0] == s.m0 && e[1] == s.m1 && xi_line >= -kKeepEdge &&
+                      xi_line <= 1 + kKeepEdge;
+    const bool on_edge = xi_line > 0 && xi_line < 1;
+    const double xi = kept ? xi_line : std::clamp(xi_line, 0.0, 1.0);
+    const double qx = px - ax - xi * ex, qy = py - ay - xi * ey;
+    const double d = std::hypot(qx, qy);
+    const double le = std::sqrt(l2);
+    Vec2 n{ey / le, -ex / le};
+    double g = qx * n[0] + qy * n[1];
+    const bool vertex = !kept && !on_edge && d > kVertexDistance * le;
+    if (vertex) {
+      const int v = xi <= 0 ? e[0] : e[1];
+      Vec2 nv{0, 0};
+      for (int j : surf.vertex_edges[v]) {
+        const Vec2 nj = edge_normal(j);
+        nv[0] += nj[0], nv[1] += nj[1];
+      }
+      const double sign = qx * nv[0] + qy * nv[1] < 0 ? -1.0 : 1.0;
+      n = {sign * qx / d, sign * qy / d};
+      g = sign * d;
+    }
+    if (g < -reach && !(kept && s.active)) continue;  // the body's other side
+    const double rank = kept ? d - kKeepEdge * le : d;
+    if (rank < best) {
+      best = rank, best_edge = k, best_xi = xi, best_gap = g, best_normal = n;
+      best_vertex = vertex;
+    }
+  }
+  if (best_edge < 0) {
+    s.gap = std::numeric_limits<double>::infinity();
+    s.m0 = s.m1 = -1;
+    s.xi = 0;
+    return;
+  }
+  const auto& e = mesh.surface[best_edge];
+  s.gap = best_gap;
+  s.normal = best_normal;
+  if (best_vertex) {
+    s.m0 = best_xi <= 0 ? e[0] : e[1];
+    s.m1 = -1;
+    s.xi = 0;
+  } else {
+    s.m0 = e[0];
+    s.m1 = e[1];
+    s.xi = best_xi;
+  }
 }
 
 }  // namespace solid

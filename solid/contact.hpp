@@ -1,6 +1,6 @@
 // Frictionless node-to-segment contact (paper Eq. 3-4, Wriggers 2006): every surface node of a
-// slave body is a candidate against the surface of a master body (elastic or rigid) or a rigid
-// plane. The signed gap g = (x_s - x_p) . n, with x_p the closest point of the master surface and
+// slave body is a candidate against the surface of a master body (elastic or rigid), against the
+// far parts of its own surface (self-contact: slave body == master body), or a rigid plane. The signed gap g = (x_s - x_p) . n, with x_p the closest point of the master surface and
 // n its outward normal, is negative inside the master (inside is decided by ray casting, so deep
 // penetration is caught too). Active constraints g = 0 are enforced by Lagrange multipliers
 // lambda >= 0 (contact_solve.cpp); this file only does the geometry.
@@ -51,9 +51,16 @@ class ContactSet {
   struct Surface {
     const Mesh* mesh = nullptr;
     std::vector<int> nodes;  // nodes on the surface
+    // Self-contact only (empty otherwise), indexed by mesh node: the surface edges a node may
+    // touch (those far from it in the reference configuration), and the surface edges that
+    // meet at the node (for the sign of a gap to a vertex).
+    std::vector<std::vector<int>> self_edges;
+    std::vector<std::vector<int>> vertex_edges;
   };
+  void setup_self(Surface& s) const;
   void detect_slot(ContactSlot& s, const std::vector<const std::vector<double>*>& x,
                    const std::vector<std::array<double, 4>>& boxes, double reach) const;
+  void detect_self(ContactSlot& s, const std::vector<double>& x, double reach) const;
   std::vector<Surface> m_surfaces;
   std::vector<ContactPlane> m_planes;
   std::vector<ContactSlot> m_slots;

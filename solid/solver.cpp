@@ -40,9 +40,11 @@ Solver::Solver(Model model, LinearSolver::Backend backend)
     kinds.push_back(b->spec.kind);
   }
   for (const auto& p : m_model.contacts)
-    if (p.slave < 0 || p.master < 0 || p.slave >= num_bodies() || p.master >= num_bodies() ||
-        p.slave == p.master)
-      throw fsi::InputError("a contact pair needs two different bodies");
+    if (p.slave < 0 || p.master < 0 || p.slave >= num_bodies() || p.master >= num_bodies())
+      throw fsi::InputError("a contact pair names a body the model does not have");
+    else if (p.slave == p.master && !m_bodies[p.slave]->is_elastic())
+      throw fsi::InputError(fmt::format("self-contact of body '{}', which is rigid",
+                                        m_bodies[p.slave]->spec.name));
   m_contact.setup(meshes, kinds, m_model.contacts, m_model.planes);
   update_rigid(0);
   update_prescribed(0);
@@ -64,9 +66,10 @@ void Solver::check_initial_overlap() {
     if (s.gap < -tol && (!worst || s.gap < worst->gap)) worst = &s;
   if (!worst) return;
   const Body& S = *m_bodies[worst->slave_body];
-  const std::string other = worst->master_body < 0
-                                ? fmt::format("contact plane {}", worst->plane)
-                                : fmt::format("body '{}'", m_bodies[worst->master_body]->spec.name);
+  const std::string other =
+      worst->master_body < 0                       ? fmt::format("contact plane {}", worst->plane)
+      : worst->master_body == worst->slave_body    ? std::string("its own surface (self-contact)")
+                                                   : fmt::format("body '{}'", m_bodies[worst->master_body]->spec.name);
   throw fsi::InputError(fmt::format(
       "body '{}' and {} overlap at t = 0: node {} of '{}' at ({:.6g}, {:.6g}) is {:.3g} inside "
       "{}, beyond the contact tolerance {:.3g} ([solid] contact_tolerance = {:g} of the "

@@ -212,6 +212,17 @@ TEST_CASE("unknown keys and wrong choices", "[config][input]") {
   CHECK_THROWS_WITH(read("contact.toml", "[solid]\n" + block +
                                              "[[solid.contact]]\nbodies = [\"block\", \"lid\"]\n"),
                     Catch::Contains("solid.contact[0].bodies") && Catch::Contains("\"lid\""));
+  // A body named twice is a self-contact: read as one pair; two_way has no meaning there.
+  const Config self = read("self.toml", "[solid]\n" + block +
+                                            "[[solid.contact]]\nbodies = [\"block\", \"block\"]\n");
+  REQUIRE(self.model.contacts.size() == 1);
+  CHECK(self.model.contacts[0].slave == 0);
+  CHECK(self.model.contacts[0].master == 0);
+  CHECK_THROWS_WITH(read("self_two_way.toml",
+                         "[solid]\n" + block +
+                             "[[solid.contact]]\nbodies = [\"block\", \"block\"]\ntwo_way = true\n"),
+                    Catch::Contains("solid.contact[0].two_way") &&
+                        Catch::Contains("self-contact") && Catch::Contains("self_two_way.toml"));
   CHECK_THROWS_WITH(
       read("probe.toml",
            "[solid]\n" + block + "[[solid.body.probe]]\nname = \"P\"\npoint = [3, 3]\n"),

@@ -227,3 +227,119 @@ TEST_CASE("mirrored blocks touching at t = 0: Newton converges through impact an
       CHECK(worst_gap >= -1e-8 * 0.4);   // no penetration
     }
 }
+
+namespace {
+
+// A U: [0, 0.5] x [0, 1] (10 x 20 cells of 0.05) without the slot (0.15, 0.35) x (0.2, 1], so
+// two arms 0.15 wide and 0.8 high, 0.2 apart, on a base 0.2 high. Boundaries: "bottom", and
+// "arm_top" (the left arm's top edge).
+Mesh u_mesh() {
+  const Mesh full = rectangle_mesh(0, 0, 0.5, 1, 10, 20, Diagonals::right);
+  auto in_slot = [](double x, double y) { return x > 0.15 && x < 0.35 && y > 0.2; };
+  Mesh m;
+  std::vector<int> map(full.num_nodes(), -1);
+  auto node = [&](int n) {
+    if (map[n] < 0) {
+      map[n] = m.num_nodes();
+      m.x.push_back(full.x[2 * n]);
+      m.x.push_back(full.x[2 * n + 1]);
+    }
+    return map[n];
+  };
+  for (const auto& t : full.triangles) {
+    double cx = 0, cy = 0;
+    for (int n : t) cx += full.x[2 * n] / 3, cy += full.x[2 * n + 1] / 3;
+    if (in_slot(cx, cy)) continue;
+    m.triangles.push_back({node(t[0]), node(t[1]), node(t[2])});
+    m.triangle_region.push_back(0);
+  }
+  m.region_names = {"body"};
+  for (const auto& e : full.boundaries.at("bottom")) m.boundaries["bottom"].push_back({map[e[0]], map[e[1]]});
+  for (const auto& e : full.boundaries.at("top"))
+    if (full.x[2 * e[0]] <= 0.15 + 1e-12 && full.x[2 * e[1]] <= 0.15 + 1e-12)
+      m.boundaries["arm_top"].push_back({map[e[0]], map[e[1]]});
+  m.source = "U";
+  finalize_mesh(m);
+  return m;
+}
+
+// Is point (px, py) inside a triangle of body b's mesh at positions x whose reference centroid
+// has x > 0.25 (the right arm and the base's right half)?
+bool inside_right_part(const Mesh& mesh, const std::vector<double>& x, double px, double py) {
+  for (const auto& t : mesh.triangles) {
+    double cx = 0;
+    for (int n : t) cx += mesh.x[2 * n] / 3;
+    if (cx <= 0.25) continue;
+    double s[3];
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      s[k] = (x[2 * b] - x[2 * a]) * (py - x[2 * a + 1]) - (x[2 * b + 1] - x[2 * a + 1]) * (px - x[2 * a]);
+    }
+    if (s[0] > 0 && s[1] > 0 && s[2] > 0) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+// The left arm of a U is pushed sideways across the slot, 0.3 against the slot's 0.2: with
+// self-contact it stops on the right arm (no node of the left arm inside the right one, the
+// contact forces on the body sum to zero); without, the same push takes it through.
+TEST_CASE("self-contact: a U's arm pushed onto its other arm stops there", "[contact]") {
+  for (bool self : {true, false}) {
+    INFO((self ? "with" : "without") << " self-contact");
+    Model model;
+    model.settings.analysis = Analysis::statics;
+    model.settings.load_steps = 10;
+    model.settings.newton_tolerance = 1e-10;
+    BodySpec b;
+    b.name = "u";
+    b.mesh = u_mesh();
+    b.materials = {Material::from_young(MaterialModel::neo_hookean, 1e4, 0.3, 1)};
+    Constraint push = fixed("arm_top");
+    push.type = Constraint::Type::displacement;
+    push.displacement = {0.3, 0};
+    b.constraints = {fixed("bottom"), push};
+    model.bodies = {b};
+    if (self) {
+      ContactPair p;
+      p.slave = p.master = 0;
+      p.two_way = false;
+      model.contacts = {p};
+    }
+    Solver s(model);
+    const auto reps = s.solve_static();
+    int most = 0;
+    for (const auto& r : reps) {
+      CHECK(r.converged);
+      most = std::max(most, r.iterations);
+    }
+    INFO("most Newton iterations in a load step " << most << ", active contacts at the end "
+                                                  << reps.back().active_contacts);
+    CHECK(most <= 12);
+    const Mesh& mesh = s.mesh(0);
+    const auto& x = s.positions(0);
+    int inside = 0;
+    for (int n = 0; n < mesh.num_nodes(); ++n)
+      if (mesh.x[2 * n] < 0.2 && inside_right_part(mesh, x, x[2 * n], x[2 * n + 1])) ++inside;
+    INFO(inside << " nodes of the left arm inside the right part");
+    if (self) {
+      CHECK(inside == 0);
+      CHECK(reps.back().active_contacts > 0);
+      CHECK(s.min_contact_gap() >= -1e-8 * 0.15);
+      const Vec2 fc = s.total_contact_force(0);
+      const Vec2 push_force = s.reaction(0, "arm_top");
+      INFO("contact force sum " << fc[0] << ", " << fc[1] << "; push " << push_force[0]);
+      CHECK(push_force[0] > 0);
+      CHECK(std::hypot(fc[0], fc[1]) <= 1e-8 * push_force[0]);
+      // The right arm carries part of the push: the contact pressure on it is not zero.
+      double fmax = 0;
+      const auto& c = s.contact_forces(0);
+      for (int n = 0; n < mesh.num_nodes(); ++n)
+        if (mesh.x[2 * n] > 0.3) fmax = std::max(fmax, std::abs(c[2 * n]));
+      CHECK(fmax > 1e-3 * push_force[0]);
+    } else {
+      CHECK(inside > 0);
+    }
+  }
+}
