@@ -110,26 +110,41 @@ void ContactSet::setup(const std::vector<const Mesh*>& meshes, const std::vector
         m_slots.push_back(c);
       }
     }
+  m_front.assign(m_slots.size(), {-1, -1});
 }
 
 void ContactSet::setup_self(Surface& s) const {
   const Mesh& m = *s.mesh;
   const auto& X = m.x;
-  double longest = 0;
-  for (const auto& e : m.surface)
-    longest = std::max(longest, std::hypot(X[2 * e[1]] - X[2 * e[0]], X[2 * e[1] + 1] - X[2 * e[0] + 1]));
-  const double near = kSelfNear * longest;
-  s.self_edges.assign(m.num_nodes(), {});
+  auto length = [&](const std::array<int, 2>& e) {
+    return std::hypot(X[2 * e[1]] - X[2 * e[0]], X[2 * e[1] + 1] - X[2 * e[0] + 1]);
+  };
   s.vertex_edges.assign(m.num_nodes(), {});
   for (std::size_t k = 0; k < m.surface.size(); ++k)
     for (int v : m.surface[k]) s.vertex_edges[v].push_back(static_cast<int>(k));
-  for (int n : s.nodes)
+  // Node n does not look at edge k when they are within kSelfNear times the longer of n's
+  // surface edges and k in the reference configuration (local lengths: a graded mesh's long
+  // edges do not widen the small edges' neighbourhoods).
+  s.self_near.assign(m.num_nodes(), {});
+  for (int n : s.nodes) {
+    double ln = 0;
+    for (int k : s.vertex_edges[n]) ln = std::max(ln, length(m.surface[k]));
     for (std::size_t k = 0; k < m.surface.size(); ++k) {
       const auto& e = m.surface[k];
+      const double near = kSelfNear * std::max(ln, length(e));
       if (segment_distance(X[2 * n], X[2 * n + 1], X[2 * e[0]], X[2 * e[0] + 1], X[2 * e[1]],
-                           X[2 * e[1] + 1]) > near)
-        s.self_edges[n].push_back(static_cast<int>(k));
+                           X[2 * e[1] + 1]) <= near)
+        s.self_near[n].push_back(static_cast<int>(k));
     }
+  }
+}
+
+void ContactSet::remember_fronts() {
+  for (std::size_t k = 0; k < m_slots.size(); ++k) {
+    const ContactSlot& c = m_slots[k];
+    const bool front = c.master_body == c.slave_body && c.m0 >= 0 && (c.active || c.gap >= 0);
+    m_front[k] = front ? std::array<int, 2>{c.m0, c.m1} : std::array<int, 2>{-1, -1};
+  }
 }
 
 void ContactSet::detect(const std::vector<const std::vector<double>*>& x,
@@ -163,7 +178,8 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
     s.xi = 0;
     return;
   }
-  if (s.master_body == s.slave_body) return detect_self(s, *x[s.slave_body], reach);
+  if (s.master_body == s.slave_body)
+    return detect_self(s, m_front[&s - m_slots.data()], *x[s.slave_body], reach);
   const auto& box = boxes[s.master_body];
   const double dx = std::max({box[0] - px, 0.0, px - box[2]});
   const double dy = std::max({box[1] - py, 0.0, py - box[3]});
@@ -256,17 +272,24 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
 
 // Self-contact, a node of a body against its own surface. Three differences from two bodies:
 // - A surface is at distance 0 of itself near every node: a node looks only at the edges
-//   farther than kSelfNear longest surface edges from it in the reference configuration
-//   (Surface::self_edges). Parts nearer than that in the reference never touch.
+//   farther than kSelfNear of the local surface edge lengths from it in the reference
+//   configuration (Surface::self_near lists the others). Parts nearer never touch.
 // - Inside is not decided by ray casting (the node lies on the very surface it would cast
 //   against) but by the edge's normal; at a vertex v by the sum of the two edges' normals there,
 //   n_v (the pseudo-normal: when v is the closest point of the surface, (p - v) . n_v > 0
 //   exactly outside, at a convex and a concave vertex alike; Baerentzen & Aanaes 2005).
 // - A feature with the node behind it by more than `reach` is the body's other side, not a
-//   contact: it is passed over (the slot's own active edge excepted). So self-penetration
-//   deeper than `reach` in one step would not be seen; the step moves nodes far less.
-// Features: the closest edge (within the kKeepEdge rule of detect_slot) or vertex among those.
-void ContactSet::detect_self(ContactSlot& s, const std::vector<double>& x, double reach) const {
+//   contact, and is passed over; except the edges at the slot's front feature (what it faced
+//   at the start of the step, remember_fronts) and at its feature while it is active (the
+//   guarded edges). A node behind a guarded edge has gone through it: that edge is its
+//   feature, even if the body's other side is nearer by then. So a node driven through the
+//   surface it faced within one Newton iteration is still caught in the next; a node driven
+//   through a surface that was not its closest at the step's start, deeper than `reach` in one
+//   iteration, would not be.
+// The closest remaining feature wins, with detect_slot's rules: ties prefer the edge whose
+// interior holds the projection, and the last edge extended by kKeepEdge is kept.
+void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
+                             const std::vector<double>& x, double reach) const {
   const Surface& surf = m_surfaces[s.slave_body];
   const Mesh& mesh = *surf.mesh;
   const double px = x[2 * s.slave_node], py = x[2 * s.slave_node + 1];
@@ -276,12 +299,28 @@ void ContactSet::detect_self(ContactSlot& s, const std::vector<double>& x, doubl
     const double l = std::hypot(ex, ey);
     return Vec2{ey / l, -ex / l};
   };
-  double best = std::numeric_limits<double>::max();
-  int best_edge = -1;
-  double best_xi = 0, best_gap = 0;
-  Vec2 best_normal{0, 0};
-  bool best_vertex = false;
-  for (int k : surf.self_edges[s.slave_node]) {
+  // Nodes whose edges are never passed over as the body's other side.
+  const int guard[4] = {front[0], front[1], s.active ? s.m0 : -1, s.active ? s.m1 : -1};
+  auto guarded = [&](const std::array<int, 2>& e) {
+    for (int g : guard)
+      if (g >= 0 && (e[0] == g || e[1] == g)) return true;
+    return false;
+  };
+  struct Feature {
+    double rank = std::numeric_limits<double>::max();
+    int edge = -1;
+    double xi = 0, gap = 0;
+    Vec2 normal{0, 0};
+    bool vertex = false;
+  };
+  Feature closest, through;  // through: the closest guarded feature the node is behind
+  const auto& near = surf.self_near[s.slave_node];  // sorted
+  std::size_t skip = 0;
+  for (int k = 0; k < static_cast<int>(mesh.surface.size()); ++k) {
+    if (skip < near.size() && near[skip] == k) {
+      ++skip;
+      continue;
+    }
     const auto& e = mesh.surface[k];
     const double ax = x[2 * e[0]], ay = x[2 * e[0] + 1];
     const double ex = x[2 * e[1]] - ax, ey = x[2 * e[1] + 1] - ay;
@@ -290,18 +329,35 @@ void ContactSet::detect_self(ContactSlot& s, const std::vector<double>& x, doubl
     // The slot's last edge, extended by kKeepEdge of its length (detect_slot's rule).
     const bool kept = e[0] == s.m0 && e[1] == s.m1 && xi_line >= -kKeepEdge &&
                       xi_line <= 1 + kKeepEdge;
-    const bool on_edge = xi_line > 0 && xi_line < 1;
     const double xi = kept ? xi_line : std::clamp(xi_line, 0.0, 1.0);
     const double qx = px - ax - xi * ex, qy = py - ay - xi * ey;
     const double d = std::hypot(qx, qy);
     const double le = std::sqrt(l2);
+    const double rank = kept ? d - kKeepEdge * le : d;
+    const bool guard_edge = guarded(e);
+    if (!guard_edge && rank > closest.rank * (1 + kClosestTie)) continue;  // cannot win
+    const bool interior = xi > 0 && xi < 1;
     Vec2 n{ey / le, -ex / le};
     double g = qx * n[0] + qy * n[1];
-    const bool vertex = !kept && !on_edge && d > kVertexDistance * le;
+    const bool vertex = !kept && !interior && d > kVertexDistance * le;
     if (vertex) {
       const int v = xi <= 0 ? e[0] : e[1];
+      const auto& ve = surf.vertex_edges[v];
+      if (ve.size() == 2) {
+        // v is the closest point of its two edges only beyond the end of the one arriving
+        // (a -> v: (p - v) . t_a >= 0) and before the start of the one leaving (v -> b:
+        // (p - v) . t_b <= 0). Elsewhere an edge next to v is nearer: it is the feature if the
+        // node may touch it; if not (it is in the node's neighbourhood: a far vertex of the
+        // node's own face, seen along the face) v is no feature and its sign is meaningless.
+        const auto& e0 = mesh.surface[ve[0]];
+        const auto& in = e0[1] == v ? e0 : mesh.surface[ve[1]];
+        const auto& out = e0[0] == v ? e0 : mesh.surface[ve[1]];
+        const double ta = (-qx) * (x[2 * v] - x[2 * in[0]]) + (-qy) * (x[2 * v + 1] - x[2 * in[0] + 1]);
+        const double tb = (-qx) * (x[2 * out[1]] - x[2 * v]) + (-qy) * (x[2 * out[1] + 1] - x[2 * v + 1]);
+        if (ta < 0 || tb > 0) continue;
+      }
       Vec2 nv{0, 0};
-      for (int j : surf.vertex_edges[v]) {
+      for (int j : ve) {
         const Vec2 nj = edge_normal(j);
         nv[0] += nj[0], nv[1] += nj[1];
       }
@@ -309,13 +365,21 @@ void ContactSet::detect_self(ContactSlot& s, const std::vector<double>& x, doubl
       n = {sign * qx / d, sign * qy / d};
       g = sign * d;
     }
-    if (g < -reach && !(kept && s.active)) continue;  // the body's other side
-    const double rank = kept ? d - kKeepEdge * le : d;
-    if (rank < best) {
-      best = rank, best_edge = k, best_xi = xi, best_gap = g, best_normal = n;
-      best_vertex = vertex;
-    }
+    if (g < -reach && !guard_edge) continue;  // the body's other side
+    auto offer = [&](Feature& f) {
+      if (rank < f.rank * (1 - kClosestTie) || (rank <= f.rank * (1 + kClosestTie) && interior))
+        f = {rank, k, xi, g, n, vertex};
+    };
+    offer(closest);
+    if (guard_edge && g < 0) offer(through);
   }
+  // Behind what it faced (or touched): that is the contact, even when the body's other side is
+  // nearer by then.
+  const Feature& f = through.edge >= 0 ? through : closest;
+  const int best_edge = f.edge;
+  const double best_xi = f.xi, best_gap = f.gap;
+  const Vec2 best_normal = f.normal;
+  const bool best_vertex = f.vertex;
   if (best_edge < 0) {
     s.gap = std::numeric_limits<double>::infinity();
     s.m0 = s.m1 = -1;

@@ -44,6 +44,9 @@ class ContactSet {
   // (a lower bound of its gap, > reach) and no feature. A caller that turns slots with
   // gap < reach into constraints so always finds their feature.
   void detect(const std::vector<const std::vector<double>*>& x, const std::vector<double>& reach);
+  // Self-contact: each slot's feature (when it faces it or touches it) becomes its front for
+  // the coming step (detect_self). Called at the start of every step from the last detection.
+  void remember_fronts();
   std::vector<ContactSlot>& slots() { return m_slots; }
   const std::vector<ContactSlot>& slots() const { return m_slots; }
 
@@ -51,19 +54,21 @@ class ContactSet {
   struct Surface {
     const Mesh* mesh = nullptr;
     std::vector<int> nodes;  // nodes on the surface
-    // Self-contact only (empty otherwise), indexed by mesh node: the surface edges a node may
-    // touch (those far from it in the reference configuration), and the surface edges that
-    // meet at the node (for the sign of a gap to a vertex).
-    std::vector<std::vector<int>> self_edges;
+    // Self-contact only (empty otherwise), indexed by mesh node: the surface edges a node never
+    // touches (those near it in the reference configuration; sorted), and the surface edges
+    // that meet at the node (for the sign of a gap to a vertex).
+    std::vector<std::vector<int>> self_near;
     std::vector<std::vector<int>> vertex_edges;
   };
   void setup_self(Surface& s) const;
   void detect_slot(ContactSlot& s, const std::vector<const std::vector<double>*>& x,
                    const std::vector<std::array<double, 4>>& boxes, double reach) const;
-  void detect_self(ContactSlot& s, const std::vector<double>& x, double reach) const;
+  void detect_self(ContactSlot& s, const std::array<int, 2>& front, const std::vector<double>& x,
+                   double reach) const;
   std::vector<Surface> m_surfaces;
   std::vector<ContactPlane> m_planes;
   std::vector<ContactSlot> m_slots;
+  std::vector<std::array<int, 2>> m_front;  // per slot (self-contact), remember_fronts
 };
 
 // Second derivative of the gap to a segment, g = (x_s - x_1) . n with n = (e_y, -e_x) / l,

@@ -66,6 +66,7 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
   double previous = std::numeric_limits<double>::infinity();
   bool contact_active_or_open = false;  // the last iteration had contact candidates
   const bool had_increment = m_dirichlet_pending;
+  m_contact.remember_fronts();  // self-contact: what each node faced at the step's start
 
   for (int it = 0;; ++it) {
     auto t0 = clock::now();
