@@ -22,6 +22,10 @@ constexpr double kKeepEdge = 1e-6;
 // body's longest surface edges in the reference configuration (its own neighbourhood, and the
 // other side of a part thinner than that).
 constexpr double kSelfNear = 3;
+// Self-contact: features farther than this many reaches (smallest surface edges) from a node
+// are not looked for; its slot is then far (gap +infinity), and it has no front for the next
+// step. A candidate needs a gap below one reach.
+constexpr double kSelfSearch = 4;
 
 // Distance from p to the segment a-b.
 double segment_distance(double px, double py, double ax, double ay, double bx, double by) {
@@ -286,6 +290,7 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
 //   surface it faced within one Newton iteration is still caught in the next; a node driven
 //   through a surface that was not its closest at the step's start, deeper than `reach` in one
 //   iteration, would not be.
+// Only features within kSelfSearch reaches are looked for (a box test first).
 // The closest remaining feature wins, with detect_slot's rules: ties prefer the edge whose
 // interior holds the projection, and the last edge extended by kKeepEdge is kept.
 void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
@@ -315,6 +320,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
   };
   Feature closest, through;  // through: the closest guarded feature the node is behind
   const auto& near = surf.self_near[s.slave_node];  // sorted
+  const double search = kSelfSearch * reach;
   std::size_t skip = 0;
   for (int k = 0; k < static_cast<int>(mesh.surface.size()); ++k) {
     if (skip < near.size() && near[skip] == k) {
@@ -322,6 +328,14 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
       continue;
     }
     const auto& e = mesh.surface[k];
+    const bool guard_edge = guarded(e);
+    // Farther than `search` along x or y from the edge's box: not a feature (unless guarded).
+    if (!guard_edge) {
+      const double x0 = x[2 * e[0]], x1 = x[2 * e[1]], y0 = x[2 * e[0] + 1], y1 = x[2 * e[1] + 1];
+      if (px < std::min(x0, x1) - search || px > std::max(x0, x1) + search ||
+          py < std::min(y0, y1) - search || py > std::max(y0, y1) + search)
+        continue;
+    }
     const double ax = x[2 * e[0]], ay = x[2 * e[0] + 1];
     const double ex = x[2 * e[1]] - ax, ey = x[2 * e[1] + 1] - ay;
     const double l2 = ex * ex + ey * ey;
@@ -334,8 +348,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     const double d = std::hypot(qx, qy);
     const double le = std::sqrt(l2);
     const double rank = kept ? d - kKeepEdge * le : d;
-    const bool guard_edge = guarded(e);
-    if (!guard_edge && rank > closest.rank * (1 + kClosestTie)) continue;  // cannot win
+    if (!guard_edge && (d > search || rank > closest.rank * (1 + kClosestTie))) continue;
     const bool interior = xi > 0 && xi < 1;
     Vec2 n{ey / le, -ex / le};
     double g = qx * n[0] + qy * n[1];
