@@ -365,8 +365,8 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
         const auto& e0 = mesh.surface[ve[0]];
         const auto& in = e0[1] == v ? e0 : mesh.surface[ve[1]];
         const auto& out = e0[0] == v ? e0 : mesh.surface[ve[1]];
-        const double ta = (-qx) * (x[2 * v] - x[2 * in[0]]) + (-qy) * (x[2 * v + 1] - x[2 * in[0] + 1]);
-        const double tb = (-qx) * (x[2 * out[1]] - x[2 * v]) + (-qy) * (x[2 * out[1] + 1] - x[2 * v + 1]);
+        const double ta = qx * (x[2 * v] - x[2 * in[0]]) + qy * (x[2 * v + 1] - x[2 * in[0] + 1]);
+        const double tb = qx * (x[2 * out[1]] - x[2 * v]) + qy * (x[2 * out[1] + 1] - x[2 * v + 1]);
         if (ta < 0 || tb > 0) continue;
       }
       Vec2 nv{0, 0};

@@ -374,8 +374,9 @@ TEST_CASE("self-contact: a U's arm pushed onto its other arm stops there", "[con
 // smallest surface edge) within one Newton iteration: the next detection still finds that face
 // (the slot's front), with the depth and the face's normal. Passed over as "the body's other
 // side", the node would instead be given the right arm's outer face 0.05 away and be pushed out
-// through it.
-TEST_CASE("self-contact: a node driven deep through the face it faced is caught", "[contact]") {
+// through it. Then the node outside and inside a convex corner.
+TEST_CASE("self-contact: a node driven deep through the face it faced is caught; corners",
+          "[contact]") {
   const Mesh mesh = u_mesh();
   int n = -1;  // the left arm's inner face at y = 0.6
   for (int k = 0; k < mesh.num_nodes(); ++k)
@@ -404,4 +405,21 @@ TEST_CASE("self-contact: a node driven deep through the face it faced is caught"
   CHECK(slot().gap == Approx(-0.1));
   CHECK(slot().normal[0] == Approx(-1.0));
   CHECK(std::abs(mesh.x[2 * slot().m0] - 0.35) < 1e-12);  // the right arm's inner face
+  // Outside a convex corner (the right arm's top left, (0.35, 1)), diagonally: the corner is the
+  // feature, at its distance, with the direction from it as the normal.
+  set.remember_fronts();
+  x[2 * n] = 0.33, x[2 * n + 1] = 1.02;
+  set.detect({&x}, reach);
+  CHECK(slot().m1 == -1);
+  CHECK(std::abs(mesh.x[2 * slot().m0] - 0.35) < 1e-12);
+  CHECK(std::abs(mesh.x[2 * slot().m0 + 1] - 1.0) < 1e-12);
+  CHECK(slot().gap == Approx(std::hypot(0.02, 0.02)));
+  CHECK(slot().normal[0] == Approx(-std::sqrt(0.5)));
+  CHECK(slot().normal[1] == Approx(std::sqrt(0.5)));
+  // Inside the right arm just below that corner, nearer its top than its inner face: the top.
+  set.remember_fronts();
+  x[2 * n] = 0.37, x[2 * n + 1] = 0.99;
+  set.detect({&x}, reach);
+  CHECK(slot().gap == Approx(-0.01));
+  CHECK(slot().normal[1] == Approx(1.0));
 }
