@@ -394,9 +394,14 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
   const Vec2 best_normal = f.normal;
   const bool best_vertex = f.vertex;
   if (best_edge < 0) {
+    // No feature: far. An active slot can get here too (its vertex, seen from where the edge
+    // next to it is in the node's neighbourhood, is no feature): it is released, since a
+    // constraint without a feature has no row of B.
     s.gap = std::numeric_limits<double>::infinity();
     s.m0 = s.m1 = -1;
     s.xi = 0;
+    s.active = false;
+    s.lambda = 0;
     return;
   }
   const auto& e = mesh.surface[best_edge];

@@ -134,7 +134,8 @@ Solver::ContactLinearisation Solver::linearise_contact(
     } else {
       con.worst_gap = std::max(con.worst_gap, -s.gap);
     }
-    if (s.active || s.gap < m_bodies[s.slave_body]->min_edge)
+    // A slot against a body without its master feature cannot be a row of B (it is far).
+    if ((s.active || s.gap < m_bodies[s.slave_body]->min_edge) && (s.master_body < 0 || s.m0 >= 0))
       con.candidates.push_back(static_cast<int>(&s - slots.data()));
   }
   con.rows.resize(con.candidates.size());

@@ -45,6 +45,10 @@ void LinearSolver::analyze(const Eigen::SparseMatrix<double>& lower) {
   if (m->requested == Backend::cholmod) {
     m->llt.analyzePattern(lower);
     m->llt_analyzed = true;
+    // A new pattern: the LDL^T fallback's analysis (of an earlier pattern, if any) is stale;
+    // factorising with its permutation read out of bounds (a crash when contact entries grew
+    // the pattern after a fallback).
+    m->ldlt_analyzed = false;
     return;
   }
 #endif
