@@ -26,6 +26,9 @@ constexpr double kSelfNear = 3;
 // are not looked for; its slot is then far (gap +infinity), and it has no front for the next
 // step. A candidate needs a gap below one reach.
 constexpr double kSelfSearch = 4;
+// Self-contact: a node within this fraction of the shorter edge at a vertex (twice that while
+// the vertex is already its feature) touches the vertex, with the vertex's pseudo-normal.
+constexpr double kSelfVertexZone = 0.01;
 
 // Distance from p to the segment a-b.
 double segment_distance(double px, double py, double ax, double ay, double bx, double by) {
@@ -290,6 +293,8 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
 //   surface it faced within one Newton iteration is still caught in the next; a node driven
 //   through a surface that was not its closest at the step's start, deeper than `reach` in one
 //   iteration, would not be.
+// - Within a vertex's zone (kSelfVertexZone) the vertex is the feature, with its pseudo-normal,
+//   from whichever of its edges it is found.
 // Only features within kSelfSearch reaches are looked for (a box test first).
 // The closest remaining feature wins, with detect_slot's rules: ties prefer the edge whose
 // interior holds the projection, and the last edge extended by kKeepEdge is kept.
@@ -343,7 +348,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     // The slot's last edge, extended by kKeepEdge of its length (detect_slot's rule).
     const bool kept = e[0] == s.m0 && e[1] == s.m1 && xi_line >= -kKeepEdge &&
                       xi_line <= 1 + kKeepEdge;
-    const double xi = kept ? xi_line : std::clamp(xi_line, 0.0, 1.0);
+    double xi = kept ? xi_line : std::clamp(xi_line, 0.0, 1.0);
     const double qx = px - ax - xi * ex, qy = py - ay - xi * ey;
     const double d = std::hypot(qx, qy);
     const double le = std::sqrt(l2);
@@ -352,8 +357,38 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     const bool interior = xi > 0 && xi < 1;
     Vec2 n{ey / le, -ex / le};
     double g = qx * n[0] + qy * n[1];
-    const bool vertex = !kept && !interior && d > kVertexDistance * le;
-    if (vertex) {
+    bool vertex = !kept && !interior && d > kVertexDistance * le;
+    // Near a vertex v, within its zone: the feature is v, with the pseudo-normal n_v and the
+    // gap (p - v) . n_v, whichever of v's two edges is examined. Two surface nodes pressed
+    // onto each other (a curled fold tip's two shoulders: each node at the other's vertex)
+    // otherwise took the edge on one side of v, were placed by its constraint where the edge
+    // on the other side was the closer, and switched between the two at every iteration.
+    int zone = -1;
+    for (int v : e) {
+      const auto& ve = surf.vertex_edges[v];
+      if (ve.size() != 2) continue;
+      double shortest = std::numeric_limits<double>::max();
+      for (int j : ve) {
+        const auto& ej = mesh.surface[j];
+        shortest = std::min(shortest, std::hypot(x[2 * ej[1]] - x[2 * ej[0]],
+                                                 x[2 * ej[1] + 1] - x[2 * ej[0] + 1]));
+      }
+      const double r = kSelfVertexZone * shortest * (s.m1 < 0 && s.m0 == v ? 2 : 1);
+      if (std::hypot(px - x[2 * v], py - x[2 * v + 1]) <= r) zone = v;
+    }
+    Vec2 nv{0, 0};
+    if (zone >= 0)
+      for (int j : surf.vertex_edges[zone]) {
+        const Vec2 nj = edge_normal(j);
+        nv[0] += nj[0], nv[1] += nj[1];
+      }
+    const double ln = std::hypot(nv[0], nv[1]);
+    if (zone >= 0 && ln > 1e-6) {  // (a vertex whose edges fold back onto each other has none)
+      n = {nv[0] / ln, nv[1] / ln};
+      g = (px - x[2 * zone]) * n[0] + (py - x[2 * zone + 1]) * n[1];
+      vertex = true;
+      xi = zone == e[0] ? 0 : 1;
+    } else if (vertex) {
       const int v = xi <= 0 ? e[0] : e[1];
       const auto& ve = surf.vertex_edges[v];
       if (ve.size() == 2) {

@@ -423,3 +423,58 @@ TEST_CASE("self-contact: a node driven deep through the face it faced is caught;
   CHECK(slot().gap == Approx(-0.01));
   CHECK(slot().normal[1] == Approx(1.0));
 }
+
+// Two corners of the surface touching each other (the left arm's top right moved onto the
+// right arm's top left, within the vertex zone): each node's feature is the other node, with
+// that vertex's pseudo-normal, from whichever side of the vertex the node lies. With the edges'
+// normals, a node on a vertex switched between the vertex's two edges from one Newton
+// iteration to the next. Away from the vertex, the edge is the feature.
+TEST_CASE("self-contact: a node at a vertex touches the vertex, with its pseudo-normal",
+          "[contact]") {
+  const Mesh mesh = u_mesh();
+  auto find = [&](double px, double py) {
+    for (int k = 0; k < mesh.num_nodes(); ++k)
+      if (std::abs(mesh.x[2 * k] - px) < 1e-12 && std::abs(mesh.x[2 * k + 1] - py) < 1e-12)
+        return k;
+    return -1;
+  };
+  const int a = find(0.15, 1.0), b = find(0.35, 1.0);
+  REQUIRE(a >= 0);
+  REQUIRE(b >= 0);
+  ContactSet set;
+  ContactPair self;
+  self.slave = self.master = 0;
+  self.two_way = false;
+  set.setup({&mesh}, {BodyKind::elastic}, {self}, {});
+  auto slot = [&](int n) -> const ContactSlot& {
+    for (const auto& s : set.slots())
+      if (s.slave_node == n) return s;
+    FAIL("no slot for node " << n);
+    return set.slots().front();
+  };
+  std::vector<double> x = mesh.x;
+  const std::vector<double> reach = {0.05};
+  const double r = std::sqrt(0.5);  // b's pseudo-normal is (-r, r): its edges face up and left
+  // a just inside the right arm, by 1e-4 along each of b's two edges (edges of 0.05: the zone
+  // is 5e-4), and diagonally outside it.
+  const double offsets[3][2] = {{1e-4, -2e-5}, {2e-5, -1e-4}, {-2e-4, 2e-4}};
+  for (const auto& o : offsets) {
+    x[2 * a] = 0.35 + o[0], x[2 * a + 1] = 1.0 + o[1];
+    set.detect({&x}, reach);
+    INFO("node " << a << " at b + (" << o[0] << ", " << o[1] << "), b = node " << b);
+    CHECK(slot(a).m0 == b);
+    CHECK(slot(a).m1 == -1);
+    CHECK(slot(a).normal[0] == Approx(-r));
+    CHECK(slot(a).normal[1] == Approx(r));
+    CHECK(slot(a).gap == Approx(r * (o[1] - o[0])));
+    // And b at a's vertex.
+    CHECK(slot(b).m0 == a);
+    CHECK(slot(b).m1 == -1);
+  }
+  // Facing the middle of an edge of the right arm's inner face 0.01 away: that edge.
+  x[2 * a] = 0.34, x[2 * a + 1] = 0.925;
+  set.detect({&x}, reach);
+  CHECK(slot(a).gap == Approx(0.01));
+  CHECK(slot(a).m1 >= 0);
+  CHECK(slot(a).normal[0] == Approx(-1.0));
+}
