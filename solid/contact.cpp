@@ -29,6 +29,10 @@ constexpr double kSelfSearch = 4;
 // Self-contact: a node within this fraction of the shorter edge at a vertex (twice that while
 // the vertex is already its feature) touches the vertex, with the vertex's pseudo-normal.
 constexpr double kSelfVertexZone = 0.01;
+// Self-contact: a node behind a feature it did not face at the step's start is the body's other
+// side unless it is within this many times the distance it and the feature moved since.
+constexpr double kSelfCrossing = 2;
+const std::vector<double> kNoPositions;
 
 // Distance from p to the segment a-b.
 double segment_distance(double px, double py, double ax, double ay, double bx, double by) {
@@ -146,7 +150,10 @@ void ContactSet::setup_self(Surface& s) const {
   }
 }
 
-void ContactSet::remember_fronts() {
+void ContactSet::remember_fronts(const std::vector<const std::vector<double>*>& x) {
+  m_start.assign(m_surfaces.size(), {});
+  for (std::size_t b = 0; b < x.size() && b < m_surfaces.size(); ++b)
+    if (!m_surfaces[b].self_near.empty()) m_start[b] = *x[b];
   for (std::size_t k = 0; k < m_slots.size(); ++k) {
     const ContactSlot& c = m_slots[k];
     const bool front = c.master_body == c.slave_body && c.m0 >= 0 && (c.active || c.gap >= 0);
@@ -285,7 +292,9 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
 //   against) but by the edge's normal; at a vertex v by the sum of the two edges' normals there,
 //   n_v (the pseudo-normal: when v is the closest point of the surface, (p - v) . n_v > 0
 //   exactly outside, at a convex and a concave vertex alike; Baerentzen & Aanaes 2005).
-// - A feature with the node behind it by more than `reach` is the body's other side, not a
+// - A feature with the node behind it by more than the node can have crossed since the step's
+//   start (kSelfCrossing times the distance it and the feature's nodes moved since, at most
+//   `reach`; `reach` when no start positions were given) is the body's other side, not a
 //   contact, and is passed over; except the edges at the slot's front feature (what it faced
 //   at the start of the step, remember_fronts) and at its feature while it is active (the
 //   guarded edges). A node behind a guarded edge has gone through it: that edge is its
@@ -326,6 +335,8 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
   Feature closest, through;  // through: the closest guarded feature the node is behind
   const auto& near = surf.self_near[s.slave_node];  // sorted
   const double search = kSelfSearch * reach;
+  const std::vector<double>& start =
+      m_start.size() > static_cast<std::size_t>(s.slave_body) ? m_start[s.slave_body] : kNoPositions;
   std::size_t skip = 0;
   for (int k = 0; k < static_cast<int>(mesh.surface.size()); ++k) {
     if (skip < near.size() && near[skip] == k) {
@@ -413,7 +424,18 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
       n = {sign * qx / d, sign * qy / d};
       g = sign * d;
     }
-    if (g < -reach && !guard_edge) continue;  // the body's other side
+    // Behind a feature by more than the node can have crossed since the step's start (it was
+    // in front then, or the feature would be guarded): the body's other side.
+    double cross = reach;
+    if (!start.empty()) {
+      auto moved = [&](int v) {
+        return std::hypot(x[2 * v] - start[2 * v], x[2 * v + 1] - start[2 * v + 1]);
+      };
+      cross = std::min(reach, kSelfCrossing * (moved(s.slave_node) +
+                                               std::max(moved(e[0]), moved(e[1]))) +
+                                  kKeepEdge * reach);
+    }
+    if (g < -cross && !guard_edge) continue;
     auto offer = [&](Feature& f) {
       if (rank < f.rank * (1 - kClosestTie) || (rank <= f.rank * (1 + kClosestTie) && interior))
         f = {rank, k, xi, g, n, vertex};

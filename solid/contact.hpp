@@ -45,8 +45,10 @@ class ContactSet {
   // gap < reach into constraints so always finds their feature.
   void detect(const std::vector<const std::vector<double>*>& x, const std::vector<double>& reach);
   // Self-contact: each slot's feature (when it faces it or touches it) becomes its front for
-  // the coming step (detect_self). Called at the start of every step from the last detection.
-  void remember_fronts();
+  // the coming step (detect_self), and the positions x (one vector per body) the step starts
+  // from. Called at the start of every step from the last detection. Without positions, a
+  // node may be found up to one reach behind any feature (see detect_self).
+  void remember_fronts(const std::vector<const std::vector<double>*>& x = {});
   std::vector<ContactSlot>& slots() { return m_slots; }
   const std::vector<ContactSlot>& slots() const { return m_slots; }
 
@@ -69,6 +71,7 @@ class ContactSet {
   std::vector<ContactPlane> m_planes;
   std::vector<ContactSlot> m_slots;
   std::vector<std::array<int, 2>> m_front;  // per slot (self-contact), remember_fronts
+  std::vector<std::vector<double>> m_start;  // per body (self-contact), remember_fronts
 };
 
 // Second derivative of the gap to a segment, g = (x_s - x_1) . n with n = (e_y, -e_x) / l,

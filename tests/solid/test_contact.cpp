@@ -478,3 +478,41 @@ TEST_CASE("self-contact: a node at a vertex touches the vertex, with its pseudo-
   CHECK(slot(a).m1 >= 0);
   CHECK(slot(a).normal[0] == Approx(-1.0));
 }
+
+// A node behind a feature it did not face at the step's start counts as having gone through it
+// only as deep as it and the feature moved since (twice that): deeper, it is the body's other
+// side (a fold tip squeezed thinner than the smallest edge has its nodes behind the edges of
+// its other face). Here a node 0.02 inside the right arm below its top, having arrived there
+// in the step from 0.1 in front of the arm, is caught on the top; having been there at the
+// step's start, it is not a contact.
+TEST_CASE("self-contact: behind a feature by more than it moved is the other side", "[contact]") {
+  const Mesh mesh = u_mesh();
+  int n = -1;  // the left arm's inner face at y = 0.6
+  for (int k = 0; k < mesh.num_nodes(); ++k)
+    if (std::abs(mesh.x[2 * k] - 0.15) < 1e-12 && std::abs(mesh.x[2 * k + 1] - 0.6) < 1e-12) n = k;
+  REQUIRE(n >= 0);
+  ContactSet set;
+  ContactPair self;
+  self.slave = self.master = 0;
+  self.two_way = false;
+  set.setup({&mesh}, {BodyKind::elastic}, {self}, {});
+  auto slot = [&]() -> const ContactSlot& {
+    for (const auto& s : set.slots())
+      if (s.slave_node == n) return s;
+    FAIL("no slot for the node");
+    return set.slots().front();
+  };
+  const std::vector<double> reach = {0.05};
+  std::vector<double> x = mesh.x;
+  x[2 * n] = 0.25;  // facing the right arm 0.1 away
+  set.detect({&x}, reach);
+  set.remember_fronts({&x});
+  x[2 * n] = 0.42, x[2 * n + 1] = 0.98;
+  set.detect({&x}, reach);
+  CHECK(slot().gap == Approx(-0.02));
+  CHECK(slot().normal[1] == Approx(1.0));
+  set.remember_fronts({&x});  // the same place at the start of the next step
+  set.detect({&x}, reach);
+  CHECK(slot().m0 == -1);
+  CHECK(std::isinf(slot().gap));
+}
