@@ -370,6 +370,33 @@ TEST_CASE("self-contact: a U's arm pushed onto its other arm stops there", "[con
     }
 }
 
+namespace {
+
+// The node of the U at reference position (px, py), or -1.
+int u_node(const Mesh& mesh, double px, double py) {
+  for (int k = 0; k < mesh.num_nodes(); ++k)
+    if (std::abs(mesh.x[2 * k] - px) < 1e-12 && std::abs(mesh.x[2 * k + 1] - py) < 1e-12) return k;
+  return -1;
+}
+
+// A contact set with the mesh's self-contact only.
+void setup_self_contact(ContactSet& set, const Mesh& mesh) {
+  ContactPair self;
+  self.slave = self.master = 0;
+  self.two_way = false;
+  set.setup({&mesh}, {BodyKind::elastic}, {self}, {});
+}
+
+// The slot of node n.
+const ContactSlot& slot_of(const ContactSet& set, int n) {
+  for (const auto& s : set.slots())
+    if (s.slave_node == n) return s;
+  FAIL("no slot for node " << n);
+  return set.slots().front();
+}
+
+}  // namespace
+
 // A node driven through the face it faced at the step's start, deeper than the reach (the
 // smallest surface edge) within one Newton iteration: the next detection still finds that face
 // (the slot's front), with the depth and the face's normal. Passed over as "the body's other
@@ -378,25 +405,15 @@ TEST_CASE("self-contact: a U's arm pushed onto its other arm stops there", "[con
 TEST_CASE("self-contact: a node driven deep through the face it faced is caught; corners",
           "[contact]") {
   const Mesh mesh = u_mesh();
-  int n = -1;  // the left arm's inner face at y = 0.6
-  for (int k = 0; k < mesh.num_nodes(); ++k)
-    if (std::abs(mesh.x[2 * k] - 0.15) < 1e-12 && std::abs(mesh.x[2 * k + 1] - 0.6) < 1e-12) n = k;
+  const int n = u_node(mesh, 0.15, 0.6);  // the left arm's inner face at y = 0.6
   REQUIRE(n >= 0);
   ContactSet set;
-  ContactPair self;
-  self.slave = self.master = 0;
-  self.two_way = false;
-  set.setup({&mesh}, {BodyKind::elastic}, {self}, {});
+  setup_self_contact(set, mesh);
   std::vector<double> x = mesh.x;
   const std::vector<double> reach = {0.05};
   x[2 * n] = 0.25;  // facing the right arm 0.1 away
   set.detect({&x}, reach);
-  auto slot = [&]() -> const ContactSlot& {
-    for (const auto& s : set.slots())
-      if (s.slave_node == n) return s;
-    FAIL("no slot for the node");
-    return set.slots().front();
-  };
+  auto slot = [&]() -> const ContactSlot& { return slot_of(set, n); };
   CHECK(slot().gap == Approx(0.1));
   CHECK(slot().normal[0] == Approx(-1.0));
   set.remember_fronts();
@@ -432,26 +449,12 @@ TEST_CASE("self-contact: a node driven deep through the face it faced is caught;
 TEST_CASE("self-contact: a node at a vertex touches the vertex, with its pseudo-normal",
           "[contact]") {
   const Mesh mesh = u_mesh();
-  auto find = [&](double px, double py) {
-    for (int k = 0; k < mesh.num_nodes(); ++k)
-      if (std::abs(mesh.x[2 * k] - px) < 1e-12 && std::abs(mesh.x[2 * k + 1] - py) < 1e-12)
-        return k;
-    return -1;
-  };
-  const int a = find(0.15, 1.0), b = find(0.35, 1.0);
+  const int a = u_node(mesh, 0.15, 1.0), b = u_node(mesh, 0.35, 1.0);
   REQUIRE(a >= 0);
   REQUIRE(b >= 0);
   ContactSet set;
-  ContactPair self;
-  self.slave = self.master = 0;
-  self.two_way = false;
-  set.setup({&mesh}, {BodyKind::elastic}, {self}, {});
-  auto slot = [&](int n) -> const ContactSlot& {
-    for (const auto& s : set.slots())
-      if (s.slave_node == n) return s;
-    FAIL("no slot for node " << n);
-    return set.slots().front();
-  };
+  setup_self_contact(set, mesh);
+  auto slot = [&](int n) -> const ContactSlot& { return slot_of(set, n); };
   std::vector<double> x = mesh.x;
   const std::vector<double> reach = {0.05};
   const double r = std::sqrt(0.5);  // b's pseudo-normal is (-r, r): its edges face up and left
@@ -487,21 +490,11 @@ TEST_CASE("self-contact: a node at a vertex touches the vertex, with its pseudo-
 // step's start, it is not a contact.
 TEST_CASE("self-contact: behind a feature by more than it moved is the other side", "[contact]") {
   const Mesh mesh = u_mesh();
-  int n = -1;  // the left arm's inner face at y = 0.6
-  for (int k = 0; k < mesh.num_nodes(); ++k)
-    if (std::abs(mesh.x[2 * k] - 0.15) < 1e-12 && std::abs(mesh.x[2 * k + 1] - 0.6) < 1e-12) n = k;
+  const int n = u_node(mesh, 0.15, 0.6);  // the left arm's inner face at y = 0.6
   REQUIRE(n >= 0);
   ContactSet set;
-  ContactPair self;
-  self.slave = self.master = 0;
-  self.two_way = false;
-  set.setup({&mesh}, {BodyKind::elastic}, {self}, {});
-  auto slot = [&]() -> const ContactSlot& {
-    for (const auto& s : set.slots())
-      if (s.slave_node == n) return s;
-    FAIL("no slot for the node");
-    return set.slots().front();
-  };
+  setup_self_contact(set, mesh);
+  auto slot = [&]() -> const ContactSlot& { return slot_of(set, n); };
   const std::vector<double> reach = {0.05};
   std::vector<double> x = mesh.x;
   x[2 * n] = 0.25;  // facing the right arm 0.1 away
