@@ -27,10 +27,12 @@ constexpr double kSelfNear = 3;
 // step. A candidate needs a gap below one reach.
 constexpr double kSelfSearch = 4;
 // Self-contact: a node within this fraction of the shorter edge at a vertex (twice that while
-// the vertex is already its feature) touches the vertex, with the vertex's pseudo-normal.
+// the vertex is already its feature) touches the vertex, with the vertex's pseudo-normal as the
+// gap's gradient (detect_self).
 constexpr double kSelfVertexZone = 0.01;
 // Self-contact: a node behind a feature it did not face at the step's start is the body's other
-// side unless it is within this many times the distance it and the feature moved since.
+// side unless it is within this many times its motion since, relative to the feature's point
+// under it (plus the accepted gap, at least kKeepEdge reaches; at most one reach).
 constexpr double kSelfCrossing = 2;
 const std::vector<double> kNoPositions;
 
@@ -150,13 +152,15 @@ void ContactSet::setup_self(Surface& s) const {
   }
 }
 
-void ContactSet::remember_fronts(const std::vector<const std::vector<double>*>& x) {
+void ContactSet::remember_fronts(const std::vector<const std::vector<double>*>& x,
+                                 double gap_tol) {
+  m_gap_tol = gap_tol;
   m_start.assign(m_surfaces.size(), {});
   for (std::size_t b = 0; b < x.size() && b < m_surfaces.size(); ++b)
     if (!m_surfaces[b].self_near.empty()) m_start[b] = *x[b];
   for (std::size_t k = 0; k < m_slots.size(); ++k) {
     const ContactSlot& c = m_slots[k];
-    const bool front = c.master_body == c.slave_body && c.m0 >= 0 && (c.active || c.gap >= 0);
+    const bool front = c.master_body == c.slave_body && c.m0 >= 0 && (c.active || c.gap >= -gap_tol);
     m_front[k] = front ? std::array<int, 2>{c.m0, c.m1} : std::array<int, 2>{-1, -1};
   }
 }
@@ -293,17 +297,17 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
 //   n_v (the pseudo-normal: when v is the closest point of the surface, (p - v) . n_v > 0
 //   exactly outside, at a convex and a concave vertex alike; Baerentzen & Aanaes 2005).
 // - A feature with the node behind it by more than the node can have crossed since the step's
-//   start (kSelfCrossing times the distance it and the feature's nodes moved since, at most
-//   `reach`; `reach` when no start positions were given) is the body's other side, not a
-//   contact, and is passed over; except the edges at the slot's front feature (what it faced
+//   start (kSelfCrossing times its motion since relative to the feature's point under it, plus
+//   a floor; at most `reach`, and `reach` when no start positions were given) is the body's
+//   other side, not a contact, and is passed over; except the edges at the slot's front feature (what it faced
 //   at the start of the step, remember_fronts) and at its feature while it is active (the
 //   guarded edges). A node behind a guarded edge has gone through it: that edge is its
 //   feature, even if the body's other side is nearer by then. So a node driven through the
 //   surface it faced within one Newton iteration is still caught in the next; a node driven
-//   through a surface that was not its closest at the step's start, deeper than `reach` in one
-//   iteration, would not be.
-// - Within a vertex's zone (kSelfVertexZone) the vertex is the feature, with its pseudo-normal,
-//   from whichever of its edges it is found.
+//   through a surface that was not its closest at the step's start, deeper than that bound,
+//   would not be.
+// - Within a vertex's zone (kSelfVertexZone) the vertex is the feature, with its pseudo-normal
+//   as the normal, from whichever of its edges it is found; the gap stays the distance.
 // Only features within kSelfSearch reaches are looked for (a box test first).
 // The closest remaining feature wins, with detect_slot's rules: ties prefer the edge whose
 // interior holds the projection, and the last edge extended by kKeepEdge is kept.
@@ -369,11 +373,15 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     Vec2 n{ey / le, -ex / le};
     double g = qx * n[0] + qy * n[1];
     bool vertex = !kept && !interior && d > kVertexDistance * le;
-    // Near a vertex v, within its zone: the feature is v, with the pseudo-normal n_v and the
-    // gap (p - v) . n_v, whichever of v's two edges is examined. Two surface nodes pressed
-    // onto each other (a curled fold tip's two shoulders: each node at the other's vertex)
-    // otherwise took the edge on one side of v, were placed by its constraint where the edge
-    // on the other side was the closer, and switched between the two at every iteration.
+    // Near a vertex v, within its zone: the feature is v with the pseudo-normal n_v as its
+    // normal, whichever of v's two edges is examined. Two surface nodes pressed onto each other
+    // (a curled fold tip's two shoulders: each node at the other's vertex) otherwise took the
+    // edge on one side of v, were placed by its constraint where the edge on the other side was
+    // the closer, and switched between the two at every iteration. The gap stays the signed
+    // distance to the two edges (the nearer one's: its normal's sign for an interior
+    // projection, n_v's at v itself), continuous across the zone's border; only its gradient is
+    // taken as n_v, which errs by the angle between n_v and the nearer edge's normal (half the
+    // kink), so Newton converges linearly while a node is in a zone.
     int zone = -1;
     for (int v : e) {
       const auto& ve = surf.vertex_edges[v];
@@ -396,7 +404,19 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     const double ln = std::hypot(nv[0], nv[1]);
     if (zone >= 0 && ln > 1e-6) {  // (a vertex whose edges fold back onto each other has none)
       n = {nv[0] / ln, nv[1] / ln};
-      g = (px - x[2 * zone]) * n[0] + (py - x[2 * zone + 1]) * n[1];
+      double nearest = std::numeric_limits<double>::max();
+      for (int j : surf.vertex_edges[zone]) {
+        const auto& ej = mesh.surface[j];
+        const double bx = x[2 * ej[0]], by = x[2 * ej[0] + 1];
+        const double fx = x[2 * ej[1]] - bx, fy = x[2 * ej[1] + 1] - by;
+        const double t = std::clamp(((px - bx) * fx + (py - by) * fy) / (fx * fx + fy * fy), 0.0, 1.0);
+        const double rx = px - bx - t * fx, ry = py - by - t * fy;
+        const double dj = std::hypot(rx, ry);
+        if (dj >= nearest) continue;
+        nearest = dj;
+        const Vec2 nj = t > 0 && t < 1 ? edge_normal(j) : n;
+        g = rx * nj[0] + ry * nj[1] < 0 ? -dj : dj;
+      }
       vertex = true;
       xi = zone == e[0] ? 0 : 1;
     } else if (vertex) {
@@ -428,12 +448,13 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     // in front then, or the feature would be guarded): the body's other side.
     double cross = reach;
     if (!start.empty()) {
-      auto moved = [&](int v) {
-        return std::hypot(x[2 * v] - start[2 * v], x[2 * v + 1] - start[2 * v + 1]);
+      const double w = std::clamp(xi, 0.0, 1.0);
+      auto delta = [&](int v, int c) { return x[2 * v + c] - start[2 * v + c]; };
+      auto relative = [&](int c) {
+        return delta(s.slave_node, c) - (1 - w) * delta(e[0], c) - w * delta(e[1], c);
       };
-      cross = std::min(reach, kSelfCrossing * (moved(s.slave_node) +
-                                               std::max(moved(e[0]), moved(e[1]))) +
-                                  kKeepEdge * reach);
+      cross = std::min(reach, kSelfCrossing * std::hypot(relative(0), relative(1)) +
+                                  std::max(kKeepEdge * reach, m_gap_tol));
     }
     if (g < -cross && !guard_edge) continue;
     auto offer = [&](Feature& f) {

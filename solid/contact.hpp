@@ -46,9 +46,10 @@ class ContactSet {
   void detect(const std::vector<const std::vector<double>*>& x, const std::vector<double>& reach);
   // Self-contact: each slot's feature (when it faces it or touches it) becomes its front for
   // the coming step (detect_self), and the positions x (one vector per body) the step starts
-  // from. Called at the start of every step from the last detection. Without positions, a
-  // node may be found up to one reach behind any feature (see detect_self).
-  void remember_fronts(const std::vector<const std::vector<double>*>& x = {});
+  // from; gap_tol is the accepted gap (a slot that far inside keeps its front). Called at the
+  // start of every step from the last detection. Without positions, a node may be found up
+  // to one reach behind any feature (see detect_self).
+  void remember_fronts(const std::vector<const std::vector<double>*>& x = {}, double gap_tol = 0);
   std::vector<ContactSlot>& slots() { return m_slots; }
   const std::vector<ContactSlot>& slots() const { return m_slots; }
 
@@ -72,6 +73,7 @@ class ContactSet {
   std::vector<ContactSlot> m_slots;
   std::vector<std::array<int, 2>> m_front;  // per slot (self-contact), remember_fronts
   std::vector<std::vector<double>> m_start;  // per body (self-contact), remember_fronts
+  double m_gap_tol = 0;                       // remember_fronts
 };
 
 // Second derivative of the gap to a segment, g = (x_s - x_1) . n with n = (e_y, -e_x) / l,

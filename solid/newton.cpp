@@ -1,7 +1,6 @@
 // Newton-Raphson for one Newmark step or one static load step, with the contact conditions
 // linearised in every iteration (contact_solve.cpp): assemble the residual and tangent at the
 // iterate, add the contact terms, test convergence, factorise and solve, update the iterate.
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -70,7 +69,7 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
   {
     std::vector<const std::vector<double>*> xs;  // self-contact: what each node faced, and where,
     for (const auto& b : m_bodies) xs.push_back(&b->x);  // at the step's start
-    m_contact.remember_fronts(xs);
+    m_contact.remember_fronts(xs, gap_tol);
   }
 
   for (int it = 0;; ++it) {
@@ -90,14 +89,6 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
     const ContactLinearisation contact = linearise_contact(c0, dt, time_or_factor, external);
 
     const double rn = contact.residual.norm();
-    if (std::getenv("FSI_CONTACT_TRACE") && time_or_factor >= std::atof(std::getenv("FSI_CONTACT_TRACE")) && it < 3) {
-      fmt::print(stderr, "TRACE t {} it {} rn {:.4e}\n", time_or_factor, it, rn);
-      const auto& xx = positions(0);
-      for (int n = 16; n <= 26; ++n) fmt::print(stderr, "  X{} {:.6f} {:.6f}\n", n, xx[2*n], xx[2*n+1]);
-      for (const auto& s : m_contact.slots())
-        if (s.slave_body == 0 && (s.active || s.gap < 0.02))
-          fmt::print(stderr, "   b{} n{} -> b{} ({},{}) xi {:.3e} gap {:.3e} lam {:.3e} act {} nrm {:.4f} {:.4f}\n", s.slave_body, s.slave_node, s.master_body, s.m0, s.m1, s.xi, s.gap, s.lambda, s.active, s.normal[0], s.normal[1]);
-    }
     rep.residuals.push_back(rn);
     rep.tolerance = st.newton_tolerance * m_force_scale;
     rep.active_contacts = contact.active;

@@ -458,9 +458,11 @@ TEST_CASE("self-contact: a node at a vertex touches the vertex, with its pseudo-
   std::vector<double> x = mesh.x;
   const std::vector<double> reach = {0.05};
   const double r = std::sqrt(0.5);  // b's pseudo-normal is (-r, r): its edges face up and left
-  // a just inside the right arm, by 1e-4 along each of b's two edges (edges of 0.05: the zone
-  // is 5e-4), and diagonally outside it.
-  const double offsets[3][2] = {{1e-4, -2e-5}, {2e-5, -1e-4}, {-2e-4, 2e-4}};
+  // a just inside the right arm, 1e-4 along either of b's two edges and 2e-5 deep (edges of
+  // 0.05: the zone is 5e-4), and diagonally outside it; the gap is the distance to the nearer
+  // edge, or to b.
+  const double offsets[3][3] = {
+      {1e-4, -2e-5, -2e-5}, {2e-5, -1e-4, -2e-5}, {-2e-4, 2e-4, std::hypot(2e-4, 2e-4)}};
   for (const auto& o : offsets) {
     x[2 * a] = 0.35 + o[0], x[2 * a + 1] = 1.0 + o[1];
     set.detect({&x}, reach);
@@ -469,7 +471,7 @@ TEST_CASE("self-contact: a node at a vertex touches the vertex, with its pseudo-
     CHECK(slot(a).m1 == -1);
     CHECK(slot(a).normal[0] == Approx(-r));
     CHECK(slot(a).normal[1] == Approx(r));
-    CHECK(slot(a).gap == Approx(r * (o[1] - o[0])));
+    CHECK(slot(a).gap == Approx(o[2]));
     // And b at a's vertex.
     CHECK(slot(b).m0 == a);
     CHECK(slot(b).m1 == -1);
