@@ -127,28 +127,32 @@ std::pair<char, unsigned long long> process_stat(long pid) {
 // The launcher's watch: ./fsi exports its PID as FSI_LAUNCHER_PID; a thread of every program
 // looks twice a second whether that process still lives (not gone, not a zombie, not a new
 // process under a reused PID). When it is gone (killed, even by SIGKILL, which it cannot
-// trap), the program says so and exits; mpirun, left with dead programs, ends the rest.
+// trap), the program says so and exits; mpirun, left with dead programs, ends the rest. It
+// starts before MPI_Init, and a launcher already gone when it starts (killed while the job was
+// starting; its zombie waits for its own parent) ends the program at once: the watch used to
+// start after MPI_Init and took such a launcher for none, and the job ran on, unwatched.
 void watch_launcher(const char* role) {
   const char* env = std::getenv("FSI_LAUNCHER_PID");
   if (!env || !*env) return;
   char* end = nullptr;
   const long pid = std::strtol(env, &end, 10);
   if (*end != 0 || pid <= 1) return;
+  auto gone = [role, pid] {
+    // Not MPI_Abort: MPI is not ours to call from this thread. Every program watches and
+    // exits on its own within the same half second.
+    std::fprintf(stderr, "[%s] ERROR: the launcher ./fsi (pid %ld) is gone (killed?): ending "
+                 "the job\n", role, pid);
+    std::fflush(stderr);
+    std::_Exit(1);
+  };
   const auto first = process_stat(pid);
-  if (first.first == 0 || first.first == 'Z' || first.first == 'X') return;  // not ours to watch
+  if (first.first == 0 || first.first == 'Z' || first.first == 'X') gone();
   const unsigned long long start = first.second;
-  std::thread([role, pid, start] {
+  std::thread([gone, pid, start] {
     for (;;) {
       std::this_thread::sleep_for(std::chrono::milliseconds(500));
       const auto [s, t] = process_stat(pid);
-      if (s == 0 || s == 'Z' || s == 'X' || t != start) {
-        // Not MPI_Abort: MPI is not ours to call from this thread. Every program watches and
-        // exits on its own within the same half second.
-        std::fprintf(stderr, "[%s] ERROR: the launcher ./fsi (pid %ld) is gone (killed?): ending "
-                     "the job\n", role, pid);
-        std::fflush(stderr);
-        std::_Exit(1);
-      }
+      if (s == 0 || s == 'Z' || s == 'X' || t != start) gone();
     }
   }).detach();
 }
@@ -483,10 +487,10 @@ void check_job(const Runtime& rt, const std::vector<Announce>& all, const RoleSe
 }  // namespace
 
 int run_program(Role role, int argc, char** argv, const std::function<void(Runtime&)>& body) {
+  watch_launcher(role_name(role));
   MPI_Init(&argc, &argv);
   Runtime rt;
   rt.m_role = role;
-  watch_launcher(role_name(role));
   rt.m_t0 = MPI_Wtime();
   try {
     int world_rank = 0, world_size = 1;
