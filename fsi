@@ -442,6 +442,9 @@ print("      + 0.14-0.24 ms")
 print("  tried and not kept: the last Newton iteration's residual without its matrix (-0.2 ms")
 print("      predicted): the residual's round-off floor and a pending prescribed increment take the")
 print("      element matrices, so the step would not stay bit for bit")
+print("  each fold's self-contact (the scene's two self pairs) | the solid's detection, a few")
+print("      0.1 ms | without and with, one run each: 4.13 -> 4.21 ms per step, solid round trip")
+print("      1.03 -> 1.28 ms (16.5 -> 16.8 min for t = 12)")
 PY
 }
 
