@@ -160,7 +160,8 @@ void ContactSet::remember_fronts(const std::vector<const std::vector<double>*>& 
     if (!m_surfaces[b].self_near.empty()) m_start[b] = *x[b];
   for (std::size_t k = 0; k < m_slots.size(); ++k) {
     const ContactSlot& c = m_slots[k];
-    const bool front = c.master_body == c.slave_body && c.m0 >= 0 && (c.active || c.gap >= -gap_tol);
+    const bool front =
+        c.master_body == c.slave_body && c.m0 >= 0 && (c.active || c.gap >= -gap_tol);
     m_front[k] = front ? std::array<int, 2>{c.m0, c.m1} : std::array<int, 2>{-1, -1};
   }
 }
@@ -299,13 +300,13 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
 // - A feature with the node behind it by more than the node can have crossed since the step's
 //   start (kSelfCrossing times its motion since relative to the feature's point under it, plus
 //   a floor; at most `reach`, and `reach` when no start positions were given) is the body's
-//   other side, not a contact, and is passed over; except the edges at the slot's front feature (what it faced
-//   at the start of the step, remember_fronts) and at its feature while it is active (the
-//   guarded edges). A node behind a guarded edge has gone through it: that edge is its
-//   feature, even if the body's other side is nearer by then. So a node driven through the
-//   surface it faced within one Newton iteration is still caught in the next; a node driven
-//   through a surface that was not its closest at the step's start, deeper than that bound,
-//   would not be.
+//   other side, not a contact, and is passed over; except the edges at the slot's front
+//   feature (what it faced at the start of the step, remember_fronts) and at its feature while
+//   it is active (the guarded edges). A node behind a guarded edge has gone through it: that
+//   edge is its feature, even if the body's other side is nearer by then. So a node driven
+//   through the surface it faced within one Newton iteration is still caught in the next; a
+//   node driven through a surface that was not its closest at the step's start, deeper than
+//   that bound, would not be.
 // - Within a vertex's zone (kSelfVertexZone) the vertex is the feature, with its pseudo-normal
 //   as the normal, from whichever of its edges it is found; the gap stays the distance.
 // Only features within kSelfSearch reaches are looked for (a box test first).
@@ -339,8 +340,9 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
   Feature closest, through;  // through: the closest guarded feature the node is behind
   const auto& near = surf.self_near[s.slave_node];  // sorted
   const double search = kSelfSearch * reach;
-  const std::vector<double>& start =
-      m_start.size() > static_cast<std::size_t>(s.slave_body) ? m_start[s.slave_body] : kNoPositions;
+  const std::vector<double>& start = m_start.size() > static_cast<std::size_t>(s.slave_body)
+                                         ? m_start[s.slave_body]
+                                         : kNoPositions;
   std::size_t skip = 0;
   for (int k = 0; k < static_cast<int>(mesh.surface.size()); ++k) {
     if (skip < near.size() && near[skip] == k) {
@@ -409,7 +411,8 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
         const auto& ej = mesh.surface[j];
         const double bx = x[2 * ej[0]], by = x[2 * ej[0] + 1];
         const double fx = x[2 * ej[1]] - bx, fy = x[2 * ej[1] + 1] - by;
-        const double t = std::clamp(((px - bx) * fx + (py - by) * fy) / (fx * fx + fy * fy), 0.0, 1.0);
+        const double t =
+            std::clamp(((px - bx) * fx + (py - by) * fy) / (fx * fx + fy * fy), 0.0, 1.0);
         const double rx = px - bx - t * fx, ry = py - by - t * fy;
         const double dj = std::hypot(rx, ry);
         if (dj >= nearest) continue;

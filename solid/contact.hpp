@@ -1,9 +1,11 @@
 // Frictionless node-to-segment contact (paper Eq. 3-4, Wriggers 2006): every surface node of a
 // slave body is a candidate against the surface of a master body (elastic or rigid), against the
-// far parts of its own surface (self-contact: slave body == master body), or a rigid plane. The signed gap g = (x_s - x_p) . n, with x_p the closest point of the master surface and
-// n its outward normal, is negative inside the master (inside is decided by ray casting, so deep
-// penetration is caught too). Active constraints g = 0 are enforced by Lagrange multipliers
-// lambda >= 0 (contact_solve.cpp); this file only does the geometry.
+// far parts of its own surface (self-contact: slave body == master body), or a rigid plane. The
+// signed gap g = (x_s - x_p) . n, with x_p the closest point of the master surface and n its
+// outward normal, is negative inside the master (inside is decided by ray casting, so deep
+// penetration is caught too; for self-contact see detect_self). Active constraints g = 0 are
+// enforced by Lagrange multipliers lambda >= 0 (contact_solve.cpp); this file only does the
+// geometry.
 #pragma once
 
 #include <array>

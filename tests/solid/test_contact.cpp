@@ -254,7 +254,8 @@ Mesh u_mesh() {
     m.triangle_region.push_back(0);
   }
   m.region_names = {"body"};
-  for (const auto& e : full.boundaries.at("bottom")) m.boundaries["bottom"].push_back({map[e[0]], map[e[1]]});
+  for (const auto& e : full.boundaries.at("bottom"))
+    m.boundaries["bottom"].push_back({map[e[0]], map[e[1]]});
   for (const auto& e : full.boundaries.at("left"))
     if (full.x[2 * e[0] + 1] >= 0.5 - 1e-12 && full.x[2 * e[1] + 1] >= 0.5 - 1e-12)
       m.boundaries["arm_outer"].push_back({map[e[0]], map[e[1]]});
