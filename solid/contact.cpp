@@ -317,11 +317,23 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
   const Surface& surf = m_surfaces[s.slave_body];
   const Mesh& mesh = *surf.mesh;
   const double px = x[2 * s.slave_node], py = x[2 * s.slave_node + 1];
+  auto edge_length = [&](int k) {
+    const auto& e = mesh.surface[k];
+    return std::hypot(x[2 * e[1]] - x[2 * e[0]], x[2 * e[1] + 1] - x[2 * e[0] + 1]);
+  };
   auto edge_normal = [&](int k) {
     const auto& e = mesh.surface[k];
-    const double ex = x[2 * e[1]] - x[2 * e[0]], ey = x[2 * e[1] + 1] - x[2 * e[0] + 1];
-    const double l = std::hypot(ex, ey);
-    return Vec2{ey / l, -ex / l};
+    const double l = edge_length(k);
+    return Vec2{(x[2 * e[1] + 1] - x[2 * e[0] + 1]) / l, -(x[2 * e[1]] - x[2 * e[0]]) / l};
+  };
+  // The sum of the normals of the edges at vertex v (not normalised).
+  auto pseudo_normal = [&](int v) {
+    Vec2 nv{0, 0};
+    for (int j : surf.vertex_edges[v]) {
+      const Vec2 nj = edge_normal(j);
+      nv[0] += nj[0], nv[1] += nj[1];
+    }
+    return nv;
   };
   // Nodes whose edges are never passed over as the body's other side.
   const int guard[4] = {front[0], front[1], s.active ? s.m0 : -1, s.active ? s.m1 : -1};
@@ -388,21 +400,11 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     for (int v : e) {
       const auto& ve = surf.vertex_edges[v];
       if (ve.size() != 2) continue;
-      double shortest = std::numeric_limits<double>::max();
-      for (int j : ve) {
-        const auto& ej = mesh.surface[j];
-        shortest = std::min(shortest, std::hypot(x[2 * ej[1]] - x[2 * ej[0]],
-                                                 x[2 * ej[1] + 1] - x[2 * ej[0] + 1]));
-      }
+      const double shortest = std::min(edge_length(ve[0]), edge_length(ve[1]));
       const double r = kSelfVertexZone * shortest * (s.m1 < 0 && s.m0 == v ? 2 : 1);
       if (std::hypot(px - x[2 * v], py - x[2 * v + 1]) <= r) zone = v;
     }
-    Vec2 nv{0, 0};
-    if (zone >= 0)
-      for (int j : surf.vertex_edges[zone]) {
-        const Vec2 nj = edge_normal(j);
-        nv[0] += nj[0], nv[1] += nj[1];
-      }
+    const Vec2 nv = zone >= 0 ? pseudo_normal(zone) : Vec2{0, 0};
     const double ln = std::hypot(nv[0], nv[1]);
     if (zone >= 0 && ln > 1e-6) {  // (a vertex whose edges fold back onto each other has none)
       n = {nv[0] / ln, nv[1] / ln};
@@ -438,11 +440,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
         const double tb = qx * (x[2 * out[1]] - x[2 * v]) + qy * (x[2 * out[1] + 1] - x[2 * v + 1]);
         if (ta < 0 || tb > 0) continue;
       }
-      Vec2 nv{0, 0};
-      for (int j : ve) {
-        const Vec2 nj = edge_normal(j);
-        nv[0] += nj[0], nv[1] += nj[1];
-      }
+      const Vec2 nv = pseudo_normal(v);
       const double sign = qx * nv[0] + qy * nv[1] < 0 ? -1.0 : 1.0;
       n = {sign * qx / d, sign * qy / d};
       g = sign * d;
