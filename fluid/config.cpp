@@ -221,12 +221,17 @@ void validate(const Config& c, double dt) {
     if (b.type == BcType::wall) umax = std::max(umax, std::abs(b.velocity) + std::abs(b.amplitude));
   }
   const double hmin = std::min(min_width(c.x), min_width(c.y));
-  const double cfl = umax * dt / hmin;
+  // With substeps, the fluid's own step may be as short as dt / substeps_max.
+  const double cfl = umax * dt / hmin / c.substeps_max;
   if (cfl > c.cfl_max) {
     bad(c, fmt::format("time.dt = {:g} gives a start-up CFL number {:.4g} above the limit "
-                       "fluid.health.cfl_max = {:g} (speed {:g}, smallest cell {:g}); the largest "
-                       "stable dt is {:.6g}",
-                       dt, cfl, c.cfl_max, umax, hmin, c.cfl_max * hmin / umax));
+                       "fluid.health.cfl_max = {:g} (speed {:g}, smallest cell {:g}{}); the "
+                       "largest stable dt is {:.6g}",
+                       dt, cfl, c.cfl_max, umax, hmin,
+                       c.substeps_max > 1
+                           ? fmt::format(", {} substeps (fluid.substeps.max)", c.substeps_max)
+                           : std::string(),
+                       c.cfl_max * hmin / umax * c.substeps_max));
   }
 }
 
@@ -405,6 +410,19 @@ Config read_config(const fsi::SceneTable& f, double dt) {
     c.divergence_max = h->positive("divergence_max", 1e-6);
     c.health_every = h->positive_integer("every", 10);
     h->finish();
+  }
+  if (auto s = f.optional_table("substeps")) {
+    const long m = s->positive_integer("max", 1);
+    if (m > kMaxSubsteps)
+      s->fail("max", fmt::format("{} substeps per step: at most {}; lower time.dt instead", m,
+                                 kMaxSubsteps));
+    c.substeps_max = int(m);
+    c.substeps_cfl = s->positive("cfl", 0.8);
+    if (c.substeps_cfl > c.cfl_max)
+      s->fail("cfl", fmt::format("{:g} is above fluid.health.cfl_max = {:g}: the substeps would "
+                                 "aim above the number that stops the run", c.substeps_cfl,
+                                 c.cfl_max));
+    s->finish();
   }
   for (Side s : c.wall_shear) {
     if (c.bc[s].type != BcType::wall) {

@@ -19,6 +19,8 @@ namespace fluid {
 
 enum Side : int { left = 0, right = 1, bottom = 2, top = 3 };
 inline constexpr const char* kSideNames[4] = {"left", "right", "bottom", "top"};
+// The most fluid steps per coupled step ([fluid.substeps] max).
+inline constexpr long kMaxSubsteps = 64;
 
 enum class BcType { periodic, wall, slip, inflow, outflow, pressure };
 enum class Profile { uniform, parabolic };
@@ -97,6 +99,11 @@ struct Config {
   std::vector<Side> wall_shear;  // sides along which tau_w (Eq. 30) is written
   std::vector<double> flow_rate;  // x of the vertical sections whose volume flux is written
   double cfl_max = 1.0;          // health: stop above this CFL number
+  // [fluid.substeps]: within a coupled step of dt the fluid takes m equal steps dt / m, the
+  // fewest (at most substeps_max) whose CFL number, from the step's start velocity, is at most
+  // substeps_cfl (fluid/program.cpp). substeps_max = 1: one step of dt, no sub-cycling.
+  int substeps_max = 1;
+  double substeps_cfl = 0.8;
   double divergence_max = 1e-6;  // health: stop when max |div u| dt exceeds this (after growth)
   long health_every = 10;        // steps between divergence checks
   std::string source;            // scene file, for error messages

@@ -83,13 +83,36 @@ fsi::proto::GridInfo FluidProgram::grid_info() const {
 // The step's first part (explicit terms, boundary values, the predictor; with Crank-Nicolson its
 // right-hand side, the solve waiting for the forces) needs no coupling input. After a final step
 // it starts at once (the next step has the same dt: the coupler's clock is uniform), else on
-// step_begin.
+// step_begin. With sub-cycling it is the first substep's.
 void FluidProgram::prepare_next(const fsi::proto::StepBegin& done) {
-  m_solver->begin_step(done.dt);
+  m_solver->begin_step(done.dt / substeps(done.dt));
 }
 
 void FluidProgram::begin(const fsi::proto::StepBegin& s) {
-  if (!m_solver->is_begun()) m_solver->begin_step(s.dt);
+  if (!m_solver->is_begun()) m_solver->begin_step(s.dt / substeps(s.dt));
+}
+
+// Sub-cycling ([fluid.substeps]). C = max |u| dt / h is the CFL number of the coupled step over
+// the velocity u^n it starts from. The count m (1 .. substeps_max) rises to ceil(C / cfl) as soon
+// as C / m > cfl, and falls only once m - 1 substeps would stay below kSubstepsFall cfl: a count
+// that went back and forth from one step to the next (a CFL number near cfl x m) jolted the
+// force on a body each time, and that made a light body's explicit coupling unstable
+// (fluid/README.md, "Sub-cycling"). The health check after a step finds the next step's count
+// (m_substeps); the first step of a run finds it here. A checkpoint keeps it, so a restart
+// repeats the run.
+int FluidProgram::substeps(double dt) {
+  if (m_substeps == 0) m_substeps = substep_count(cfl(*m_solver, dt).value);
+  return m_substeps;
+}
+
+int FluidProgram::substep_count(double c) const {
+  const int max = m_cfg.substeps_max, now = std::max(1, m_substeps);
+  if (max == 1 || !std::isfinite(c)) return 1;
+  const double target = m_cfg.substeps_cfl;
+  if (c > target * now) return int(std::min<double>(max, std::ceil(c / target)));
+  int m = now;
+  while (m > 1 && c <= kSubstepsFall * target * (m - 1)) --m;
+  return m;
 }
 
 void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::FluidInput& in,
@@ -109,9 +132,16 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
   c.sample_v_index = in.sample_v;
   c.sample_p_index = in.sample_p;
   if (s.iteration == 0) {
+    if (s.may_repeat != 0 && m_cfg.substeps_max > 1)
+      throw fsi::InputError(fmt::format(
+          "fluid.substeps.max = {} in {}: the fluid's substeps cannot be redone by coupled "
+          "iterations (coupler.iterations.max > 1); use one of the two",
+          m_cfg.substeps_max, m_rt.scene().file().string()));
     m_solver->set_keep_for_redo(s.may_repeat != 0);
     begin(s);
-    m_solver->end_step(s.dt, c, m_out);
+    const int m = substeps(s.dt);
+    m_solver->end_substeps(s.dt, m, c, m_out);
+    if (m > 1) ++m_substepped, m_substeps_taken += m;
   } else {
     m_solver->redo_step(s.dt, c, m_out);
   }
@@ -127,16 +157,20 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
 }
 
 void FluidProgram::check_health(long step, double t, double dt) {
+  // The CFL number of the next step's own (sub)step: that of dt over the substeps it will take.
   const Extremum c = cfl(*m_solver, dt);
-  m_cfl = c.value;
+  m_substeps = substep_count(c.value);
+  m_cfl = c.value / m_substeps;
   std::string what;
   if (!std::isfinite(c.value)) {
     what = "the velocity is not finite (NaN or Inf)" + fsi::extreme_constants_hint();
-  } else if (c.value > m_cfg.cfl_max) {
+  } else if (m_cfl > m_cfg.cfl_max) {
     what = fmt::format(
         "CFL number {:.4g} above fluid.health.cfl_max = {:g} in cell ({}, {}) at "
-        "(x, y) = ({:.6g}, {:.6g}); lower time.dt{}",
-        c.value, m_cfg.cfl_max, c.i, c.j, c.x, c.y, fsi::extreme_constants_hint());
+        "(x, y) = ({:.6g}, {:.6g}){}; lower time.dt{}",
+        m_cfl, m_cfg.cfl_max, c.i, c.j, c.x, c.y,
+        m_substeps > 1 ? fmt::format(" with {} substeps (fluid.substeps.max)", m_substeps) : "",
+        fsi::extreme_constants_hint());
   } else if (step % m_cfg.health_every == 0) {
     const Extremum d = max_divergence(*m_solver);
     m_div = d.value;
@@ -273,6 +307,7 @@ nlohmann::json FluidProgram::flow_rate_report() const {
 void FluidProgram::save(fsi::H5File& h5) const {
   m_solver->save(&h5);
   h5.write("health", std::vector<double>{m_cfl, m_div, m_div_first, m_energy});
+  h5.write("substeps", std::vector<double>{double(m_substeps)});
 }
 
 // The other ranks' part of a checkpoint: the solver's gathers, no file.
@@ -282,6 +317,7 @@ void FluidProgram::load(const fsi::H5File& h5) {
   m_solver->load(h5);
   const auto h = h5.read_doubles("health");
   m_cfl = h.at(0), m_div = h.at(1), m_div_first = h.at(2), m_energy = h.at(3);
+  m_substeps = h5.exists("substeps") ? int(h5.read_doubles("substeps").at(0)) : 0;
 }
 
 std::string FluidProgram::status() const {
@@ -297,6 +333,11 @@ nlohmann::json FluidProgram::report() const {
   j["grid"] = {m_solver->grid().nx(), m_solver->grid().ny()};
   j["steps"] = tm.steps;
   if (tm.repeats > 0) j["repeated_steps"] = tm.repeats;
+  // Sub-cycling: "steps" counts the fluid's own steps, substeps included.
+  if (m_cfg.substeps_max > 1)
+    j["substeps"] = {{"max", m_cfg.substeps_max}, {"cfl", m_cfg.substeps_cfl},
+                     {"coupled_steps_subcycled", m_substepped},
+                     {"their_substeps", m_substeps_taken}};
   j["phases"] = {{"predictor", tm.predictor},
                  {"boundaries", tm.boundaries},
                  {"poisson", tm.poisson},

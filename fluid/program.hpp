@@ -13,6 +13,10 @@
 
 namespace fluid {
 
+// Sub-cycling: the substep count falls by one only when the CFL number over one substep fewer
+// would be at most this fraction of [fluid.substeps] cfl.
+inline constexpr double kSubstepsFall = 0.8;
+
 class FluidProgram : public fsi::FluidPort {
  public:
   explicit FluidProgram(fsi::Runtime& rt);
@@ -35,6 +39,9 @@ class FluidProgram : public fsi::FluidPort {
   nlohmann::json flow_rate_report() const;
   // Health: NaN/Inf, CFL above its limit, divergence growth. Writes the state, then throws.
   void check_health(long step, double t, double dt);
+  // Sub-cycling: the substeps of the coming step of dt, and the count for a CFL number of dt.
+  int substeps(double dt);
+  int substep_count(double cfl_of_dt) const;
 
   fsi::Runtime& m_rt;
   Config m_cfg;
@@ -52,6 +59,8 @@ class FluidProgram : public fsi::FluidPort {
   double m_cfl = 0, m_div = 0, m_div_first = -1;
   double m_energy = 0;  // kinetic energy, refreshed with the divergence every health.every steps
   long m_written_step = -1;
+  int m_substeps = 0;  // substeps of the next step (0: not known yet)
+  long m_substepped = 0, m_substeps_taken = 0;  // steps sub-cycled in this run, their substeps
 };
 
 }  // namespace fluid

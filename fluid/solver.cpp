@@ -353,6 +353,28 @@ void Solver::end_step(double dt, const CouplingIn& in, CouplingOut& out) {
   ++m_time.steps;
 }
 
+// The solid's force of a sub-cycled step is the mean (1/m) sum_k f_k of its m steps: the
+// impulse (dt/m) sum_k f_k the fluid received over the coupled step, divided by dt.
+void Solver::end_substeps(double dt, int m, const CouplingIn& in, CouplingOut& out) {
+  if (m == 1) return end_step(dt, in, out);
+  if (m < 1) fsi::fail("fluid::Solver::end_substeps: {} substeps", m);
+  const double h = dt / m;
+  m_force_sum[0].assign(in.solid_u_index.size(), 0.0);
+  m_force_sum[1].assign(in.solid_v_index.size(), 0.0);
+  for (int k = 0; k < m; ++k) {
+    if (k > 0) begin_step(h);
+    end_step(h, in, out);
+    for (std::size_t q = 0; q < m_force_sum[0].size(); ++q)
+      m_force_sum[0][q] += out.solid_u_force[q];
+    for (std::size_t q = 0; q < m_force_sum[1].size(); ++q)
+      m_force_sum[1][q] += out.solid_v_force[q];
+  }
+  for (std::size_t q = 0; q < m_force_sum[0].size(); ++q)
+    out.solid_u_force[q] = m_force_sum[0][q] / m;
+  for (std::size_t q = 0; q < m_force_sum[1].size(); ++q)
+    out.solid_v_force[q] = m_force_sum[1][q] / m;
+}
+
 void Solver::redo_step(double dt, const CouplingIn& in, CouplingOut& out) {
   if (m_phase != Phase::redoable || dt != m_dt_prev)
     fsi::fail("fluid::Solver::redo_step: no step of this dt kept for a redo");

@@ -92,6 +92,11 @@ class Solver {
   void begin_step(double dt);
   void end_step(double dt, const CouplingIn& in, CouplingOut& out);
   bool is_begun() const { return m_phase == Phase::begun; }
+  // Sub-cycling: one coupled step of dt as m equal steps dt / m with the same coupling input
+  // (the first begun by begin_step(dt / m)); the solid's force is the mean of the m steps'
+  // (their impulse over dt), the samples are the last step's. m = 1 is end_step(dt, ...).
+  // Not for coupled iterations (redo_step redoes one step).
+  void end_substeps(double dt, int m, const CouplingIn& in, CouplingOut& out);
   // Coupled iterations: the step just taken again from its predictor u~ and p^n (kept by
   // end_step() while set_keep_for_redo(true), the default), with new solid input: immersed
   // forcing, projection, samples. The fibers' force and the predictor are not recomputed
@@ -220,6 +225,7 @@ class Solver {
   // mark per face (body_viscosity.cpp), zero between steps.
   std::array<Field, 2> m_body_alpha;
   std::array<std::vector<char>, 2> m_body_mark;
+  std::array<std::vector<double>, 2> m_force_sum;  // end_substeps: the solid force's sums
   Timings m_time;
 };
 

@@ -246,6 +246,44 @@ TEST_CASE("work ahead gives the plain steps bit for bit", "[fluid][coupling]") {
   }
 }
 
+// Sub-cycling: a coupled step of dt in m substeps is m plain steps of dt / m with the same
+// input, bit for bit, for each diffusion option, with the immersed forcing and the fibers'
+// force; the solid's force is the mean of the m steps' forces (their impulse over dt); the
+// samples are the last step's. The substep count may change from one coupled step to the next.
+TEST_CASE("substeps are plain steps of dt / m; the force is their mean", "[fluid][coupling]") {
+  for (Diffusion d : kDiffusions) {
+    CAPTURE(d);
+    const Config c = with(box(BcType::periodic), d);
+    const double dt = 2e-3;
+    Solver a(c, dt), b(c, dt);
+    const int nu = a.grid().nu();
+    BlockInput block(a);
+    CouplingIn& in = block.in;
+    std::vector<std::int32_t> fu{int(10 + nu * 5)}, su{int(2 + nu * 2)};
+    std::vector<double> ffu{30.0};
+    in.fiber_u_index = fu;
+    in.fiber_u_force = ffu;
+    in.sample_u_index = su;
+    CouplingOut oa, ob;
+    for (int m : {1, 3, 2, 4}) {
+      CAPTURE(m);
+      std::vector<double> sum(block.index.size(), 0.0);
+      for (int k = 0; k < m; ++k) {
+        a.step(dt / m, in, oa);
+        for (std::size_t q = 0; q < sum.size(); ++q) sum[q] += oa.solid_u_force[q];
+      }
+      b.begin_step(dt / m);
+      b.end_substeps(dt, m, in, ob);
+      check_same(a, b, m == 1 ? oa : ob, ob);
+      for (std::size_t q = 0; q < sum.size(); ++q)
+        CHECK(ob.solid_u_force[q] == Approx(sum[q] / m).epsilon(1e-14));
+      CHECK(ob.sample_u == oa.sample_u);
+      CHECK(b.step_count() == a.step_count());
+      CHECK(b.time() == a.time());
+    }
+  }
+}
+
 // Crank-Nicolson: the momentum the step gains is the integral of the f_s it returns (doubly
 // periodic box: neither walls nor the projection take momentum), on a step from a moving state,
 // with faces the body covers (alpha = 1) and cut ones (0.6).
