@@ -419,8 +419,9 @@ Config read_config(const fsi::SceneTable& f, double dt) {
     c.substeps_max = int(m);
     c.substeps_cfl = s->positive("cfl", 0.8);
     if (c.substeps_cfl > c.cfl_max)
-      s->fail("cfl", fmt::format("{:g} is above fluid.health.cfl_max = {:g}: the substeps would "
-                                 "aim above the number that stops the run", c.substeps_cfl,
+      s->fail("cfl", fmt::format("{:g}{} is above fluid.health.cfl_max = {:g}: the substeps "
+                                 "would aim above the number that stops the run",
+                                 c.substeps_cfl, s->has("cfl") ? "" : " (the default)",
                                  c.cfl_max));
     s->finish();
   }

@@ -93,26 +93,24 @@ void FluidProgram::begin(const fsi::proto::StepBegin& s) {
 }
 
 // Sub-cycling ([fluid.substeps]). C = max |u| dt / h is the CFL number of the coupled step over
-// the velocity u^n it starts from. The count m (1 .. substeps_max) rises to ceil(C / cfl) as soon
-// as C / m > cfl, and falls only once m - 1 substeps would stay below kSubstepsFall cfl: a count
-// that went back and forth from one step to the next (a CFL number near cfl x m) jolted the
-// force on a body each time, and that made a light body's explicit coupling unstable
-// (fluid/README.md, "Sub-cycling"). The health check after a step finds the next step's count
-// (m_substeps); the first step of a run finds it here. A checkpoint keeps it, so a restart
-// repeats the run.
+// the velocity u^n it starts from; the count follows it as substep_count() says, falling by one
+// and with a margin so that a CFL number near cfl x m does not change the fluid's step length
+// back and forth. The health check after a step finds the next step's count (m_substeps); the
+// first step of a run finds it here. A checkpoint keeps it (it depends on the counts before),
+// so a restart repeats the run.
 int FluidProgram::substeps(double dt) {
-  if (m_substeps == 0) m_substeps = substep_count(cfl(*m_solver, dt).value);
+  if (m_cfg.substeps_max == 1) return 1;
+  if (m_substeps == 0)
+    m_substeps = substep_count(0, cfl(*m_solver, dt).value, m_cfg.substeps_max, m_cfg.substeps_cfl);
   return m_substeps;
 }
 
-int FluidProgram::substep_count(double c) const {
-  const int max = m_cfg.substeps_max, now = std::max(1, m_substeps);
+int substep_count(int now, double c, int max, double cfl) {
   if (max == 1 || !std::isfinite(c)) return 1;
-  const double target = m_cfg.substeps_cfl;
-  if (c > target * now) return int(std::min<double>(max, std::ceil(c / target)));
-  int m = now;
-  while (m > 1 && c <= kSubstepsFall * target * (m - 1)) --m;
-  return m;
+  now = std::max(1, now);
+  if (c > cfl * now) return int(std::min<double>(max, std::ceil(c / cfl)));
+  if (now > 1 && c <= kSubstepsFall * cfl * (now - 1)) return now - 1;
+  return now;
 }
 
 void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::FluidInput& in,
@@ -132,16 +130,11 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
   c.sample_v_index = in.sample_v;
   c.sample_p_index = in.sample_p;
   if (s.iteration == 0) {
-    if (s.may_repeat != 0 && m_cfg.substeps_max > 1)
-      throw fsi::InputError(fmt::format(
-          "fluid.substeps.max = {} in {}: the fluid's substeps cannot be redone by coupled "
-          "iterations (coupler.iterations.max > 1); use one of the two",
-          m_cfg.substeps_max, m_rt.scene().file().string()));
     m_solver->set_keep_for_redo(s.may_repeat != 0);
     begin(s);
-    const int m = substeps(s.dt);
-    m_solver->end_substeps(s.dt, m, c, m_out);
-    if (m > 1) ++m_substepped, m_substeps_taken += m;
+    m_substeps_done = substeps(s.dt);
+    m_solver->end_substeps(s.dt, m_substeps_done, c, m_out);
+    if (m_substeps_done > 1) ++m_substepped, m_substeps_taken += m_substeps_done;
   } else {
     m_solver->redo_step(s.dt, c, m_out);
   }
@@ -159,29 +152,32 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
 void FluidProgram::check_health(long step, double t, double dt) {
   // The CFL number of the next step's own (sub)step: that of dt over the substeps it will take.
   const Extremum c = cfl(*m_solver, dt);
-  m_substeps = substep_count(c.value);
-  m_cfl = c.value / m_substeps;
+  const int m = substep_count(m_substeps, c.value, m_cfg.substeps_max, m_cfg.substeps_cfl);
+  if (m_cfg.substeps_max > 1) m_substeps = m;
+  m_cfl = c.value / m;
   std::string what;
   if (!std::isfinite(c.value)) {
     what = "the velocity is not finite (NaN or Inf)" + fsi::extreme_constants_hint();
   } else if (m_cfl > m_cfg.cfl_max) {
     what = fmt::format(
         "CFL number {:.4g} above fluid.health.cfl_max = {:g} in cell ({}, {}) at "
-        "(x, y) = ({:.6g}, {:.6g}){}; lower time.dt{}",
+        "(x, y) = ({:.6g}, {:.6g}){}; lower time.dt{}{}",
         m_cfl, m_cfg.cfl_max, c.i, c.j, c.x, c.y,
-        m_substeps > 1 ? fmt::format(" with {} substeps (fluid.substeps.max)", m_substeps) : "",
-        fsi::extreme_constants_hint());
+        m > 1 ? fmt::format(" with {} substeps (fluid.substeps.max)", m) : "",
+        m > 1 ? " or raise fluid.substeps.max" : "", fsi::extreme_constants_hint());
   } else if (step % m_cfg.health_every == 0) {
     const Extremum d = max_divergence(*m_solver);
     m_div = d.value;
     m_energy = kinetic_energy(*m_solver);
     if (m_div_first < 0) m_div_first = d.value;
     // Round-off grows slowly with the field; a jump by orders of magnitude is a failure.
-    if (d.value * dt > m_cfg.divergence_max) {
+    // The fluid's own step: dt over the substeps it took.
+    const double own = dt / m_substeps_done;
+    if (d.value * own > m_cfg.divergence_max) {
       what = fmt::format(
           "divergence |div u| dt = {:.3g} above fluid.health.divergence_max = {:g} "
           "in cell ({}, {}) at (x, y) = ({:.6g}, {:.6g})",
-          d.value * dt, m_cfg.divergence_max, d.i, d.j, d.x, d.y);
+          d.value * own, m_cfg.divergence_max, d.i, d.j, d.x, d.y);
     }
   }
   if (what.empty()) return;
@@ -307,7 +303,7 @@ nlohmann::json FluidProgram::flow_rate_report() const {
 void FluidProgram::save(fsi::H5File& h5) const {
   m_solver->save(&h5);
   h5.write("health", std::vector<double>{m_cfl, m_div, m_div_first, m_energy});
-  h5.write("substeps", std::vector<double>{double(m_substeps)});
+  if (m_cfg.substeps_max > 1) h5.write("substeps", std::vector<double>{double(m_substeps)});
 }
 
 // The other ranks' part of a checkpoint: the solver's gathers, no file.
@@ -317,7 +313,14 @@ void FluidProgram::load(const fsi::H5File& h5) {
   m_solver->load(h5);
   const auto h = h5.read_doubles("health");
   m_cfl = h.at(0), m_div = h.at(1), m_div_first = h.at(2), m_energy = h.at(3);
-  m_substeps = h5.exists("substeps") ? int(h5.read_doubles("substeps").at(0)) : 0;
+  m_substeps = 0;
+  if (m_cfg.substeps_max > 1 && h5.exists("substeps")) {
+    const double m = h5.read_doubles("substeps").at(0);
+    if (!(m >= 0 && m <= m_cfg.substeps_max && m == std::floor(m)))
+      fsi::fail("fluid checkpoint: substep count {} outside 0..fluid.substeps.max = {}", m,
+                m_cfg.substeps_max);
+    m_substeps = int(m);
+  }
 }
 
 std::string FluidProgram::status() const {
@@ -333,11 +336,11 @@ nlohmann::json FluidProgram::report() const {
   j["grid"] = {m_solver->grid().nx(), m_solver->grid().ny()};
   j["steps"] = tm.steps;
   if (tm.repeats > 0) j["repeated_steps"] = tm.repeats;
-  // Sub-cycling: "steps" counts the fluid's own steps, substeps included.
+  // Sub-cycling: the coupled steps sub-cycled, their substeps, and all the fluid's own steps.
   if (m_cfg.substeps_max > 1)
     j["substeps"] = {{"max", m_cfg.substeps_max}, {"cfl", m_cfg.substeps_cfl},
                      {"coupled_steps_subcycled", m_substepped},
-                     {"their_substeps", m_substeps_taken}};
+                     {"their_substeps", m_substeps_taken}, {"fluid_steps", tm.steps}};
   j["phases"] = {{"predictor", tm.predictor},
                  {"boundaries", tm.boundaries},
                  {"poisson", tm.poisson},

@@ -17,13 +17,20 @@ namespace fluid {
 // would be at most this fraction of [fluid.substeps] cfl.
 inline constexpr double kSubstepsFall = 0.8;
 
+// The substeps of the next coupled step, from `now` (those of the last; 0: none yet) and c, the
+// CFL number of the coupled step's dt over the velocity it starts from, under [fluid.substeps]
+// max and cfl: ceil(c / cfl) (at most max) once c / now > cfl; now - 1 once
+// c / (now - 1) <= kSubstepsFall cfl; else now. 1 for a c that is not finite.
+int substep_count(int now, double c, int max, double cfl);
+
 class FluidProgram : public fsi::FluidPort {
  public:
   explicit FluidProgram(fsi::Runtime& rt);
   fsi::proto::GridInfo grid_info() const override;
   void advance(const fsi::proto::StepBegin& s, const fsi::proto::FluidInput& in,
                fsi::proto::FluidOutput& out) override;
-  bool can_iterate() const override { return true; }
+  // A sub-cycling fluid cannot redo a step (the coupler refuses coupled iterations at set-up).
+  bool can_iterate() const override { return m_cfg.substeps_max == 1; }
   void prepare_next(const fsi::proto::StepBegin& done) override;
   void begin(const fsi::proto::StepBegin& s) override;
   void output(long step, double t, bool fields) override;
@@ -39,9 +46,8 @@ class FluidProgram : public fsi::FluidPort {
   nlohmann::json flow_rate_report() const;
   // Health: NaN/Inf, CFL above its limit, divergence growth. Writes the state, then throws.
   void check_health(long step, double t, double dt);
-  // Sub-cycling: the substeps of the coming step of dt, and the count for a CFL number of dt.
+  // Sub-cycling: the substeps of the coming step of dt.
   int substeps(double dt);
-  int substep_count(double cfl_of_dt) const;
 
   fsi::Runtime& m_rt;
   Config m_cfg;
@@ -60,6 +66,7 @@ class FluidProgram : public fsi::FluidPort {
   double m_energy = 0;  // kinetic energy, refreshed with the divergence every health.every steps
   long m_written_step = -1;
   int m_substeps = 0;  // substeps of the next step (0: not known yet)
+  int m_substeps_done = 1;  // substeps of the step just taken
   long m_substepped = 0, m_substeps_taken = 0;  // steps sub-cycled in this run, their substeps
 };
 
