@@ -215,29 +215,56 @@ void Solver::add_contact_curvature(double c0, double dt, double time_or_factor,
 // The active-set update of one iteration, through the factorised K_eff: given y0 = dx = K^-1 R,
 // Y = K^-1 B^T, S = B Y and q = g + B_p du_p + B y0 give the multipliers (solve_contact_lcp);
 // then dx = y0 + Y lambda, and the active set is the lambda > 0.
+// Only a working set W of the candidates enters Y and S: the last iteration's active slots and
+// those the step without contact takes through (q_k < -tol). A candidate outside W keeps
+// lambda_k = 0, which solves the whole problem as long as its gap after the step,
+// g_k + B_k dx, stays above -tol, the gap the problem accepts; one that does not joins W and W
+// is solved again. Most candidates are open (a surface within an edge of another, of a wall
+// plane, of its own fold), and each column of Y is a solve with the factor: with W the step
+// pays for the contacts that act, not for those within reach.
 void Solver::solve_contact(const ContactLinearisation& con, double gap_tol, Eigen::VectorXd& dx) {
   auto& slots = m_contact.slots();
   const int nc = static_cast<int>(con.candidates.size());
-  Eigen::MatrixXd Bt = Eigen::MatrixXd::Zero(m_neq, nc);
-  Eigen::VectorXd q(nc);
-  for (int k = 0; k < nc; ++k) {
-    for (const auto& [e, w] : con.rows[k]) Bt(e, k) += w;
-    q[k] = slots[con.candidates[k]].gap + con.gap_shift[k];
+  // Candidate k's gap after the step d: g + B_p du_p + B_k d.
+  auto gap_after = [&](int k, const Eigen::VectorXd& d) {
+    double g = slots[con.candidates[k]].gap + con.gap_shift[k];
+    for (const auto& [e, w] : con.rows[k]) g += w * d[e];
+    return g;
+  };
+  std::vector<char> in_work(nc, 0);
+  std::vector<int> work;
+  for (int k = 0; k < nc; ++k)
+    if (slots[con.candidates[k]].active || gap_after(k, dx) < -gap_tol)
+      work.push_back(k), in_work[k] = 1;
+  const Eigen::VectorXd y0 = dx;
+  Eigen::VectorXd lambda;
+  while (!work.empty()) {
+    const int nw = static_cast<int>(work.size());
+    Eigen::MatrixXd Bt = Eigen::MatrixXd::Zero(m_neq, nw);
+    Eigen::VectorXd q(nw);
+    std::vector<bool> warm(nw);
+    for (int a = 0; a < nw; ++a) {
+      for (const auto& [e, w] : con.rows[work[a]]) Bt(e, a) += w;
+      q[a] = gap_after(work[a], y0);
+      warm[a] = slots[con.candidates[work[a]]].active;
+    }
+    const Eigen::MatrixXd Y = m_linear.solve(Bt);
+    const Eigen::MatrixXd S = Bt.transpose() * Y;
+    lambda = solve_contact_lcp(S, q, gap_tol, warm);
+    dx = y0 + Y * lambda;
+    bool grown = false;
+    for (int k = 0; k < nc; ++k)
+      if (!in_work[k] && gap_after(k, dx) < -gap_tol) work.push_back(k), in_work[k] = 1, grown = true;
+    if (!grown) break;
   }
-  const Eigen::MatrixXd Y = m_linear.solve(Bt);
-  const Eigen::MatrixXd S = Bt.transpose() * Y;
-  q += Bt.transpose() * dx;
-  std::vector<bool> warm(nc);
-  for (int k = 0; k < nc; ++k) warm[k] = slots[con.candidates[k]].active;
-  const Eigen::VectorXd lambda = solve_contact_lcp(S, q, gap_tol, warm);
-  dx += Y * lambda;
   for (auto& s : slots) {
     s.active = false;
     s.lambda = 0;
   }
-  for (int k = 0; k < nc; ++k) {
-    slots[con.candidates[k]].lambda = lambda[k];
-    slots[con.candidates[k]].active = lambda[k] > 0;
+  for (std::size_t a = 0; a < work.size() && a < std::size_t(lambda.size()); ++a) {
+    ContactSlot& s = slots[con.candidates[work[a]]];
+    s.lambda = lambda[a];
+    s.active = lambda[a] > 0;
   }
 }
 

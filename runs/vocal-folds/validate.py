@@ -23,6 +23,10 @@ contact between them.
   these clearances only (and no pressure-inlet run). --dt DT: the coupled runs' time step (the
   paper's 5e-5 by default), every output under OUT/dt-DT. --wall-planes: each fold kept on its
   side of its wall by a rigid contact plane ([[solid.plane]]), every output under OUT/planes.
+  --substeps M: the fluid sub-cycles, up to M steps per coupled step at a CFL number of at most
+  0.8 each ([fluid.substeps]; fluid/README.md), every output under OUT/substeps-M.
+  --checkpoint-interval T: the coupled runs write a checkpoint every T (`./fsi run SCENE
+  --restart RUN` resumes one; the outputs are unchanged).
 With no option (`./fsi validate vocal-folds`): --modes, --short and --sweep."""
 import fcntl
 import json
@@ -69,6 +73,10 @@ P.add_argument("--wall-planes", action="store_true",
                help="a rigid contact plane at each wall, for the fold fixed on it")
 P.add_argument("--dt", type=cli.positive, default=None,
                help="the coupled runs' time step (default: the scene's, the paper's 5e-5)")
+P.add_argument("--substeps", type=int, metavar="M", default=None,
+               help="the fluid up to M substeps per step, each at a CFL number of at most 0.8")
+P.add_argument("--checkpoint-interval", type=cli.positive, metavar="T", default=None,
+               help="the coupled runs write a checkpoint every T")
 ARGS = P.parse_args()
 if not (ARGS.modes or ARGS.short or ARGS.run is not None or ARGS.sweep):
     ARGS.modes = ARGS.short = ARGS.sweep = True
@@ -83,6 +91,9 @@ if ARGS.dt is not None:
     os.makedirs(OUT, exist_ok=True)
 if ARGS.wall_planes:
     OUT = job.OUT = os.path.join(OUT, "planes")
+    os.makedirs(OUT, exist_ok=True)
+if ARGS.substeps is not None:
+    OUT = job.OUT = os.path.join(OUT, f"substeps-{ARGS.substeps}")
     os.makedirs(OUT, exist_ok=True)
 HERE = os.path.dirname(os.path.abspath(__file__))
 GEO = os.path.join(HERE, "fold.geo")
@@ -119,6 +130,10 @@ bodies = ["upper"]
 """, 1)
     if ARGS.dt is not None and fluid:
         text = text.replace("dt = 5e-5", f"dt = {ARGS.dt!r}")
+    if ARGS.checkpoint_interval is not None and fluid:
+        text = text.replace("[output]\n", f"[output]\ncheckpoint_interval = {ARGS.checkpoint_interval!r}\n", 1)
+    if ARGS.substeps is not None and fluid:
+        text += f"\n[fluid.substeps]\nmax = {ARGS.substeps}\ncfl = 0.8\n"
     text = text.replace("t_end = 10.0", f"t_end = {t_end!r}").replace("interval = 0.05", f"interval = {interval!r}")
     if p_sub is not None:
         # The physical alternative at a closed glottis: the subglottal pressure is given, the
