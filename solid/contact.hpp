@@ -70,12 +70,14 @@ class ContactSet {
                    const std::vector<std::array<double, 4>>& boxes, double reach) const;
   void detect_self(ContactSlot& s, const std::array<int, 2>& front, const std::vector<double>& x,
                    double reach) const;
+  void join_vertex_pairs(const std::vector<const std::vector<double>*>& x);
   std::vector<Surface> m_surfaces;
   std::vector<ContactPlane> m_planes;
   std::vector<ContactSlot> m_slots;
   std::vector<std::array<int, 2>> m_front;  // per slot (self-contact), remember_fronts
   std::vector<std::vector<double>> m_start;  // per body (self-contact), remember_fronts
   double m_gap_tol = 0;                       // remember_fronts
+  std::vector<std::vector<int>> m_self_slot;  // per body, per node: its self-contact slot or -1
 };
 
 // Second derivative of the gap to a segment, g = (x_s - x_1) . n with n = (e_y, -e_x) / l,

@@ -443,10 +443,12 @@ TEST_CASE("self-contact: a node driven deep through the face it faced is caught;
 }
 
 // Two corners of the surface touching each other (the left arm's top right moved onto the
-// right arm's top left, within the vertex zone): each node's feature is the other node, with
-// that vertex's pseudo-normal, from whichever side of the vertex the node lies. With the edges'
-// normals, a node on a vertex switched between the vertex's two edges from one Newton
-// iteration to the next. Away from the vertex, the edge is the feature.
+// right arm's top left, within the vertex zone): each node's feature is the other node, from
+// whichever side of the vertex the node lies (with the edges' normals, a node on a vertex
+// switched between the vertex's two edges from one Newton iteration to the next). The two
+// slots are one point contact: one normal between the vertices' pseudo-normals (outward at b
+// for a's slot, the opposite for b's) and one gap, (a - b) . n, with the sign of a's side.
+// Away from the vertex, the edge is the feature.
 TEST_CASE("self-contact: a node at a vertex touches the vertex, with its pseudo-normal",
           "[contact]") {
   const Mesh mesh = u_mesh();
@@ -460,22 +462,25 @@ TEST_CASE("self-contact: a node at a vertex touches the vertex, with its pseudo-
   const std::vector<double> reach = {0.05};
   const double r = std::sqrt(0.5);  // b's pseudo-normal is (-r, r): its edges face up and left
   // a just inside the right arm, 1e-4 along either of b's two edges and 2e-5 deep (edges of
-  // 0.05: the zone is 5e-4), and diagonally outside it; the gap is the distance to the nearer
-  // edge, or to b.
-  const double offsets[3][3] = {
-      {1e-4, -2e-5, -2e-5}, {2e-5, -1e-4, -2e-5}, {-2e-4, 2e-4, std::hypot(2e-4, 2e-4)}};
+  // 0.05: the zone is 5e-4), and diagonally outside it (the sign of the gap).
+  const double offsets[3][3] = {{1e-4, -2e-5, -1}, {2e-5, -1e-4, -1}, {-2e-4, 2e-4, 1}};
   for (const auto& o : offsets) {
     x[2 * a] = 0.35 + o[0], x[2 * a + 1] = 1.0 + o[1];
     set.detect({&x}, reach);
     INFO("node " << a << " at b + (" << o[0] << ", " << o[1] << "), b = node " << b);
     CHECK(slot(a).m0 == b);
     CHECK(slot(a).m1 == -1);
-    CHECK(slot(a).normal[0] == Approx(-r));
-    CHECK(slot(a).normal[1] == Approx(r));
-    CHECK(slot(a).gap == Approx(o[2]));
-    // And b at a's vertex.
-    CHECK(slot(b).m0 == a);
+    CHECK(slot(b).m0 == a);  // and b at a's vertex
     CHECK(slot(b).m1 == -1);
+    const Vec2 n = slot(a).normal;
+    CHECK(std::hypot(n[0], n[1]) == Approx(1.0));
+    CHECK(slot(b).normal[0] == -n[0]);
+    CHECK(slot(b).normal[1] == -n[1]);
+    CHECK(n[0] * -r + n[1] * r > 0.5);  // outward at b
+    const double g = (x[2 * a] - x[2 * b]) * n[0] + (x[2 * a + 1] - x[2 * b + 1]) * n[1];
+    CHECK(slot(a).gap == g);
+    CHECK(slot(b).gap == g);
+    CHECK(g * o[2] > 0);
   }
   // Facing the middle of an edge of the right arm's inner face 0.01 away: that edge.
   x[2 * a] = 0.34, x[2 * a + 1] = 0.925;
