@@ -50,6 +50,7 @@ void SolidProgram::save(fsi::H5File& h5) const {
   h5.write("solid/clock", std::vector<double>{s.time, s.contact_force_factor});
   h5.write("solid/counts", std::vector<std::int64_t>{s.step, m_steps, m_repeats, m_newton_total, m_newton_max});
   h5.write("solid/t_end", std::vector<double>{m_rt.settings().t_end});
+  h5.write("solid/contact_entries", m_solver->contact_entries());
   const KeptFactor k = m_solver->kept_factor();
   h5.write("solid/kept_factor", k.values);
   h5.write("solid/kept_factor_info", std::vector<double>{k.c0, k.matrix_floor});
@@ -77,6 +78,8 @@ void SolidProgram::load(const fsi::H5File& h5) {
   s.step = counts.at(0), m_steps = counts.at(1), m_repeats = counts.at(2);
   m_newton_total = counts.at(3), m_newton_max = counts.at(4);
   m_solver->restore_state(s);
+  if (h5.exists("solid/contact_entries"))
+    m_solver->restore_contact_entries(h5.read_int64s("solid/contact_entries"));
   KeptFactor k;
   if (h5.exists("solid/kept_factor") && h5.exists("solid/kept_factor_info")) {
     k.values = h5.read_doubles("solid/kept_factor");

@@ -196,6 +196,24 @@ bool Solver::factorize_cached() {
   return true;
 }
 
+std::vector<std::int64_t> Solver::contact_entries() const {
+  std::vector<std::int64_t> pairs;
+  for (const auto& [r, c] : m_contact_entries) pairs.push_back(r), pairs.push_back(c);
+  return pairs;
+}
+
+void Solver::restore_contact_entries(const std::vector<std::int64_t>& pairs) {
+  if (pairs.size() % 2 != 0) fsi::fail("restore_contact_entries: {} values, not pairs", pairs.size());
+  bool grown = false;
+  for (std::size_t k = 0; k < pairs.size(); k += 2) {
+    const int r = static_cast<int>(pairs[k]), c = static_cast<int>(pairs[k + 1]);
+    if (r < 0 || c < 0 || r >= m_neq || c >= m_neq || c > r)
+      fsi::fail("restore_contact_entries: entry ({}, {}) outside the {} equations", r, c, m_neq);
+    grown = m_contact_entries.insert({r, c}).second || grown;
+  }
+  if (grown) build_pattern();
+}
+
 KeptFactor Solver::kept_factor() const {
   if (!(m_keep_factor && m_factored_valid && m_contact.empty())) return {};
   return {m_factored, m_factored_c0, m_matrix_floor};

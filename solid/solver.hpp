@@ -103,6 +103,11 @@ class Solver {
   // one (empty otherwise); a resumed run factorises them again, so it continues bit for bit.
   KeptFactor kept_factor() const;
   void restore_kept_factor(const KeptFactor& k);
+  // Checkpoints: the entries contact added to the sparse pattern (pairs of equations). A resumed
+  // run builds the same pattern, so its factor's ordering, and its round-off, are the same.
+  // Restore them before the kept factor (a new pattern forgets the factor).
+  std::vector<std::int64_t> contact_entries() const;
+  void restore_contact_entries(const std::vector<std::int64_t>& pairs);
   // A step that the coupler may repeat (coupled iterations) starts from a fresh factor, so that a
   // repeat with the same forces gives the same bits (the kept factor is not part of StepState).
   void allow_kept_factor(bool allow) { m_keep_permitted = allow; }
