@@ -208,6 +208,7 @@ void ContactSet::detect(const std::vector<const std::vector<double>*>& x,
 void ContactSet::join_vertex_pairs(const std::vector<const std::vector<double>*>& x) {
   for (std::size_t b = 0; b < m_self_slot.size(); ++b) {
     const auto& index = m_self_slot[b];
+    if (index.empty()) continue;
     const std::vector<double>& xb = *x[b];
     for (int ka : index) {
       if (ka < 0) continue;

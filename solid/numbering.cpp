@@ -206,10 +206,11 @@ void Solver::restore_contact_entries(const std::vector<std::int64_t>& pairs) {
   if (pairs.size() % 2 != 0) fsi::fail("restore_contact_entries: {} values, not pairs", pairs.size());
   bool grown = false;
   for (std::size_t k = 0; k < pairs.size(); k += 2) {
-    const int r = static_cast<int>(pairs[k]), c = static_cast<int>(pairs[k + 1]);
+    const std::int64_t r = pairs[k], c = pairs[k + 1];
     if (r < 0 || c < 0 || r >= m_neq || c >= m_neq || c > r)
-      fsi::fail("restore_contact_entries: entry ({}, {}) outside the {} equations", r, c, m_neq);
-    grown = m_contact_entries.insert({r, c}).second || grown;
+      fsi::fail("checkpoint: the contact pattern's entry ({}, {}) is outside the {} equations "
+                "(a damaged checkpoint, or one of another model)", r, c, m_neq);
+    grown = m_contact_entries.insert({int(r), int(c)}).second || grown;
   }
   if (grown) build_pattern();
 }

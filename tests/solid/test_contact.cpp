@@ -449,7 +449,7 @@ TEST_CASE("self-contact: a node driven deep through the face it faced is caught;
 // slots are one point contact: one normal between the vertices' pseudo-normals (outward at b
 // for a's slot, the opposite for b's) and one gap, (a - b) . n, with the sign of a's side.
 // Away from the vertex, the edge is the feature.
-TEST_CASE("self-contact: a node at a vertex touches the vertex, with its pseudo-normal",
+TEST_CASE("self-contact: two nodes at each other's vertex are one contact",
           "[contact]") {
   const Mesh mesh = u_mesh();
   const int a = u_node(mesh, 0.15, 1.0), b = u_node(mesh, 0.35, 1.0);
