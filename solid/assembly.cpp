@@ -39,6 +39,7 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
   if (with_matrix) {
     std::fill_n(m_matrix.valuePtr(), m_matrix.nonZeros(), 0.0);
     m_matrix_c0 = c0;
+    m_matrix_curved = false;
   }
   m_residual.setZero();
   double scale2 = 0, floor2 = 0;

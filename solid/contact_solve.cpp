@@ -101,6 +101,12 @@ Eigen::VectorXd solve_contact_lcp(const Eigen::MatrixXd& S0, const Eigen::Vector
 
 }  // namespace
 
+bool Solver::any_contact_active() const {
+  for (const auto& s : m_contact.slots())
+    if (s.active) return true;
+  return false;
+}
+
 // The accepted gap: contact_tolerance times the smallest surface edge of the elastic bodies.
 double Solver::contact_gap_tolerance() const {
   double gap_tol = std::numeric_limits<double>::max();
@@ -197,6 +203,7 @@ void Solver::add_contact_curvature(double c0, double dt, double time_or_factor,
     assemble(c0, dt, true, time_or_factor, external);
   }
   double* values = m_matrix.valuePtr();
+  if (!slot_eqs.empty()) m_matrix_curved = true;
   for (std::size_t q = 0; q < slot_eqs.size(); ++q) {
     const ContactSlot& s = slots[slot_index[q]];
     const auto& xs = m_bodies[s.slave_body]->x;

@@ -23,16 +23,16 @@ void Solver::keep_step_start() {
 }
 
 void Solver::factorize_ahead(double dt) {
+  m_ahead_fresh = false;
   if (m_bodies.empty() || m_neq == 0 || m_model.settings.analysis != Analysis::dynamic) return;
   // Active contact adds its curvature to iteration 0's matrix after assembly: no match to hope for.
-  for (const auto& s : m_contact.slots())
-    if (s.active) return;
+  if (any_contact_active()) return;
   // The step starts with the factor it holds (newton.cpp, kKeepRatio): nothing to do ahead.
   if (m_keep_factor && m_factored_valid && m_contact.empty() && m_factored_c0 == newmark_c0(dt))
     return;
   keep_step_start();  // as advance() begins (the residual's inertia reads them)
   assemble(newmark_c0(dt), dt, true, m_time + dt, nullptr);
-  if (m_residual.allFinite()) factorize_cached();
+  m_ahead_fresh = m_residual.allFinite() && factorize_cached();
 }
 
 // One step t^n -> t^(n+1) = t^n + dt:

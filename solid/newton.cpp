@@ -28,11 +28,11 @@ constexpr int kContactsNamed = 8;
 // Residuals of the last iterations a failed step shows.
 constexpr std::size_t kResidualsNamed = 5;
 // A later iteration of a step solves with the factor of an earlier one (modified Newton) while
-// the residual falls by at least this factor per iteration and this iteration has no contact
-// candidates (the reused factor may still hold an earlier iteration's contact curvature, which
-// costs convergence speed only): the
-// tangent then changes too little within the step to matter (a step of a body whose inertia
-// term 4M/dt^2 dominates its stiffness); a slower fall factorises the current tangent.
+// the residual falls by at least this factor per iteration and neither that factor's matrix nor
+// this iteration's holds contact curvature (an active slot's; open candidates add rows to the
+// complementarity problem, not to the matrix): the tangent then changes too little within the
+// step to matter (a step of a body whose inertia term 4M/dt^2 dominates its stiffness); a
+// slower fall factorises the current tangent.
 constexpr double kReuseRatio = 1e-2;
 // A dynamic step starts with the factor the last step solved with (kept across steps) when that
 // step's first solve cut the residual by at least this factor: the matrix of a body whose
@@ -66,6 +66,11 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
   double previous = std::numeric_limits<double>::infinity();
   bool contact_active_or_open = false;  // the last iteration had contact candidates
   const bool had_increment = m_dirichlet_pending;
+  // The look-ahead factorised this step's first matrix (factorize_ahead): iteration 0 solves with
+  // it and assembles the residual only. Without coupled iterations (whose velocities enter the
+  // matrix), the first matrix is the one at the step's start: predict() moves no elastic node.
+  const bool ahead = m_ahead_fresh && !m_iteration_velocity;
+  m_ahead_fresh = false;
   {
     std::vector<const std::vector<double>*> xs;  // self-contact: what each node faced, and where,
     for (const auto& b : m_bodies) xs.push_back(&b->x);  // at the step's start
@@ -75,15 +80,19 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
   for (int it = 0;; ++it) {
     auto t0 = clock::now();
     m_tangent_root_mass_now = it > 0;  // add_root_mass: the first tangent takes the last step's
-    // The held factor serves this iteration (modified Newton) when it is valid, no contact can
-    // change the matrix's curvature, no prescribed increment needs the matrix in the residual,
-    // and either this is a later iteration (kept while it contracts fast, below) or a dynamic
-    // step's first iteration after a step whose first solve contracted by kKeepRatio. Such an
+    // The held factor serves this iteration (modified Newton) when it is valid, neither its
+    // matrix nor this iteration's has contact curvature (no slot active: detection releases
+    // slots, only the complementarity problem activates them), no prescribed increment needs the
+    // matrix in the residual, and either this is a later iteration (kept while it contracts
+    // fast, below), or a dynamic step's first iteration with the look-ahead's factor of this
+    // very matrix, or one after a step whose first solve contracted by kKeepRatio. Such an
     // iteration assembles the residual only; if the contraction then says "factorise", the
     // matrix is assembled at the same iterate.
+    const bool plain_factor = m_factored_valid && !m_factored_curved && !any_contact_active();
     const bool may_reuse =
-        m_factored_valid && m_contact.empty() && !m_dirichlet_pending &&
-        (it > 0 || (m_keep_allowed && m_keep_factor && m_factored_c0 == c0));
+        plain_factor && !m_dirichlet_pending &&
+        (it > 0 || (m_factored_c0 == c0 &&
+                    (ahead || (m_keep_allowed && m_keep_factor && m_contact.empty()))));
     assemble_iterate(c0, dt, time_or_factor, external, it > 0, dx, when, !may_reuse);
     rep.assembly_seconds += seconds_since(t0);
     const ContactLinearisation contact = linearise_contact(c0, dt, time_or_factor, external);
@@ -98,8 +107,7 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
       break;
     }
     if (it >= st.newton_max_iterations) break;
-    const bool reuse = contact.candidates.empty() && m_factored_valid &&
-                       (it > 0 ? rn <= kReuseRatio * previous : may_reuse);
+    const bool reuse = may_reuse && contact.active == 0 && (it == 0 || rn <= kReuseRatio * previous);
     if (!reuse && may_reuse) {
       t0 = clock::now();
       assemble(c0, dt, true, time_or_factor, external);

@@ -192,6 +192,7 @@ bool Solver::factorize_cached() {
   ++m_factorizations;
   m_factored.assign(v, v + nnz);
   m_factored_c0 = m_matrix_c0;
+  m_factored_curved = m_matrix_curved;
   m_factored_valid = true;
   return true;
 }
@@ -230,6 +231,7 @@ void Solver::restore_kept_factor(const KeptFactor& k) {
     return;
   std::copy(k.values.begin(), k.values.end(), m_matrix.valuePtr());
   m_matrix_c0 = k.c0;
+  m_matrix_curved = false;  // kept without contact only
   m_factored_valid = false;
   if (!factorize_cached()) fsi::fail("a checkpoint's kept factor is singular");
   m_keep_factor = true;

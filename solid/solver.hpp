@@ -202,6 +202,7 @@ class Solver {
                              const std::vector<std::vector<double>>* external);
   void solve_contact(const ContactLinearisation& con, double gap_tol, Eigen::VectorXd& dx);
   void store_contact_forces();
+  bool any_contact_active() const;
   void factorize(const std::string& when);
   bool factorize_cached();
   // The Newmark step's parts (newmark.cpp).
@@ -246,6 +247,11 @@ class Solver {
   bool m_keep_permitted = true;  // allow_kept_factor
   double m_matrix_c0 = 0;        // the inertia factor 4/dt^2 of the last matrix assembled
   double m_factored_c0 = 0;      // ... and of the matrix factorised
+  bool m_matrix_curved = false;    // the matrix holds contact curvature (add_contact_curvature)
+  bool m_factored_curved = false;  // ... and the matrix factorised
+  // factorize_ahead() factorised (or found factorised) this step's first matrix: the state the
+  // step starts from, its c0, no active contact. Read and cleared by the step's newton().
+  bool m_ahead_fresh = false;
   ContactSet m_contact;
   double m_contact_force_factor = 1;  // physical contact force / multiplier (1/2 in Newmark)
   bool m_dirichlet_pending = false;   // a prescribed increment awaits the first Newton solve

@@ -261,6 +261,46 @@ TEST_CASE("factorising ahead: same steps, factor reused", "[coupling]") {
   }
 }
 
+// A contact plane within reach of the bar's lower edge but never touched: its slots are open
+// candidates of every iteration, not constraints, and cost no factorisation. The steps solve with
+// the look-ahead's factor (iteration 0, the residual assembled alone) and keep it while Newton
+// contracts (modified Newton), as the bar without the plane does: the same factorisations, the
+// same motion bit for bit. (Before, any contact slot made every later iteration factorise.)
+TEST_CASE("open contact candidates keep the look-ahead's factor", "[coupling][contact]") {
+  Model free = bar(0), near = bar(0);
+  ContactPlane plane;
+  plane.point = {0, -0.03};  // within one element edge (0.05) of the lower edge
+  plane.normal = {0, 1};
+  plane.bodies = {0};
+  near.planes = {plane};
+  free.settings.keep_factor = near.settings.keep_factor = false;  // no factor kept across steps
+  Solver a(free), b(near);
+  const double dt = 1e-4;  // inertia dominates: later iterations keep the factor
+  const int steps = 40;
+  std::vector<std::vector<double>> f(2);
+  f[0].assign(a.positions(0).size(), 0.0);
+  long iterations = 0;
+  for (int n = 0; n < steps; ++n) {
+    f[0][f[0].size() - 1] = 50.0 * std::sin(0.2 * n);  // a varying load on the last node
+    a.factorize_ahead(dt);
+    a.advance(dt, &f);
+    b.factorize_ahead(dt);
+    iterations += b.advance(dt, &f).iterations;
+    REQUIRE(b.min_contact_gap() > 0.02);
+  }
+  INFO(a.factorizations() << " and " << b.factorizations() << " factorisations, "
+                          << a.factor_reuses() << " and " << b.factor_reuses() << " reuses, "
+                          << iterations << " Newton iterations in " << steps << " steps");
+  CHECK(iterations >= 2 * steps);
+  CHECK(b.factorizations() == a.factorizations());
+  CHECK(b.factor_reuses() == a.factor_reuses());
+  CHECK(b.factor_reuses() >= 2 * steps);  // iteration 0 and a later one
+  CHECK(a.displacements(0) == b.displacements(0));
+  double moved = 0;
+  for (double u : a.displacements(0)) moved = std::max(moved, std::abs(u));
+  CHECK(moved > 1e-6);
+}
+
 // A factor kept across steps (keep_factor, newton.cpp's kKeepRatio) on a body whose inertia
 // dominates its stiffness: far fewer factorisations than steps, the same motion as a fresh
 // factor every step to the Newton tolerance; and a checkpoint's kept factor (kept_factor,
