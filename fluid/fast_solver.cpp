@@ -133,6 +133,10 @@ FastSolver::FastSolver(const Operator1D& t, const Operator1D& s, double sigma)
     m_bwd = fftw_plan_many_r2r(1, n, m_ns, m_buf, nullptr, 1, m_nt, m_buf, nullptr, 1, m_nt, kb,
                                FFTW_ESTIMATE);
     m_norm = kt.norm;
+    if (DenseTransform::preferred(kt.fwd, m_nt, m_ns, m_fwd))
+      m_dense_fwd = std::make_unique<DenseTransform>(kt.fwd, m_nt, m_ns);
+    if (DenseTransform::preferred(kt.bwd, m_nt, m_ns, m_bwd))
+      m_dense_bwd = std::make_unique<DenseTransform>(kt.bwd, m_nt, m_ns);
     // Thomas factors of (a, b + lambda_k - sigma, c) for every wavenumber k; the
     // normalisation of the transform pair is folded into the first pivot's right-hand side.
     m_a = s.a;
@@ -148,10 +152,12 @@ FastSolver::~FastSolver() {
 }
 
 void FastSolver::forward() {
-  fftw_execute(m_fwd);
+  if (m_dense_fwd) m_dense_fwd->apply(m_buf);
+  else fftw_execute(m_fwd);
 }
 void FastSolver::backward() {
-  fftw_execute(m_bwd);
+  if (m_dense_bwd) m_dense_bwd->apply(m_buf);
+  else fftw_execute(m_bwd);
 }
 
 // Per wavenumber k: a_j y_{j-1} + (b_j + lambda_k - sigma) y_j + c_j y_{j+1} = rhat_j / norm,

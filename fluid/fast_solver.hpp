@@ -9,7 +9,10 @@
 
 #include <fftw3.h>
 
+#include <memory>
 #include <vector>
+
+#include "dense_transform.hpp"
 
 namespace fluid {
 
@@ -76,12 +79,17 @@ class FastSolver {
   void tridiagonal();
   void backward();
   void set_mean_weights(const std::vector<double>& w) { m_weights = w; }
+  // The t-transforms are matrix products (DenseTransform), not FFTW's plans.
+  bool dense() const { return m_dense_fwd || m_dense_bwd; }
 
  private:
   int m_nt, m_ns;
   bool m_transform_s;
   double* m_buf = nullptr;
   fftw_plan m_fwd = nullptr, m_bwd = nullptr;
+  // The t-transforms as matrix products where FFTW has only its generic O(n^2) code for the
+  // length (DenseTransform::preferred); null: FFTW's plans.
+  std::unique_ptr<DenseTransform> m_dense_fwd, m_dense_bwd;
   double m_norm = 1;
   std::vector<double> m_a;                // sub-diagonal per s-row
   std::vector<double> m_inv_piv, m_gamma;  // Thomas factors per (k, j), k fastest

@@ -1,0 +1,52 @@
+// A real transform of one of FFTW's r2r kinds done as a matrix product, for the lengths FFTW can
+// only do with its generic O(n^2) scalar code (a prime, or a large prime factor: 101 rows of the
+// vocal folds' channel at h = 0.01, 41 in 82, 123, 164): the same O(n^2) work, half of it saved by
+// the matrix's symmetry and the rest vectorised across the lines.
+#pragma once
+
+#include <fftw3.h>
+
+#include <vector>
+
+namespace fluid {
+
+class DenseTransform {
+ public:
+  // The transform `kind` of length n (FFTW's definition, unnormalised) on `lines` lines of n
+  // contiguous values each (line l at l * n).
+  DenseTransform(fftw_r2r_kind kind, int n, int lines);
+  // In place on lines * n values.
+  void apply(double* x);
+
+  // FFTW's kind as a matrix, y = C x, row-major n x n, from its defining sums.
+  static std::vector<double> matrix(fftw_r2r_kind kind, int n);
+  // Multiply-adds per line.
+  double fmas_per_line() const { return m_fmas; }
+  // The product's kernel runs vectorised (AVX2 with FMA) on this machine.
+  static bool vectorised();
+  // Use this transform instead of FFTW's plan `p` (of `lines` lines of this kind and length):
+  // only with the vectorised kernel, and when its flops are under kAdvantage times the plan's.
+  static bool preferred(fftw_r2r_kind kind, int n, int lines, const fftw_plan p);
+
+ private:
+  // How C's symmetry under index reversal r(i) = n - 1 - i halves the product:
+  //   rows:    C[k][r(j)] = s_k C[k][j] (each row even or odd): y_k = C[k][:h] (x[:h] ± x[r(:h)])
+  //   columns: C[r(k)][j] = s_j C[k][j] (each column even or odd): with a_k, b_k the sums over
+  //            the even and the odd columns (k < ceil(n/2)), y_k = a_k + b_k, y_r(k) = a_k - b_k.
+  enum class Symmetry { none, rows, columns };
+  struct Block {  // Y (rows x lines) = C_block (rows x cols) S (cols x lines)
+    int rows = 0, cols = 0;
+    std::vector<double> c;  // rows padded to a multiple of 4 (zero), row-major
+    std::vector<double> s, y;
+  };
+  void gather(const double* x);
+  void scatter(double* x) const;
+
+  int m_n, m_lines, m_stride;  // m_stride: lines padded to a multiple of 8
+  Symmetry m_sym = Symmetry::none;
+  std::vector<int> m_index[2];  // rows (Symmetry::rows) or columns (::columns) of each block
+  Block m_block[2];             // [0] even, [1] odd; Symmetry::none uses [0] only
+  double m_fmas = 0;
+};
+
+}  // namespace fluid
