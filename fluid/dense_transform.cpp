@@ -1,4 +1,5 @@
-// FFTW's real transforms as matrix products (see dense_transform.hpp).
+// FFTW's real transforms as matrix products (see dense_transform.hpp): the matrix from FFTW's
+// defining sums, its halves by symmetry, the product in register blocks across the lines.
 #include "dense_transform.hpp"
 
 #include <algorithm>
@@ -38,8 +39,7 @@ long double sin_pi(long long m, long long d) {
 // of 8), in blocks of 4 rows x 8 lines held in registers while j runs over the columns.
 using V4 = double __attribute__((vector_size(32)));
 inline __attribute__((always_inline)) void product_blocks(const double* c, int rows, int cols,
-                                                          const double* s, int stride,
-                                                          double* y) {
+                                                          const double* s, int stride, double* y) {
   for (int l0 = 0; l0 < stride; l0 += 8)
     for (int r0 = 0; r0 < rows; r0 += 4) {
       V4 a00{}, a01{}, a10{}, a11{}, a20{}, a21{}, a30{}, a31{};
@@ -66,10 +66,13 @@ inline __attribute__((always_inline)) void product_blocks(const double* c, int r
     }
 }
 
+#if defined(__x86_64__) || defined(__i386__)
+#define FSI_DENSE_AVX2 1
 __attribute__((target("avx2,fma"))) void product_avx2(const double* c, int rows, int cols,
                                                       const double* s, int stride, double* y) {
   product_blocks(c, rows, cols, s, stride, y);
 }
+#endif
 
 // Without AVX2 (the transform is then not preferred over FFTW): plain sums, same layout.
 void product_plain(const double* c, int rows, int cols, const double* s, int stride, double* y) {
@@ -100,20 +103,35 @@ double fmas_estimate(fftw_r2r_kind kind, int n) {
   }
 }
 
-int round_up(int v, int m) { return (v + m - 1) / m * m; }
+int round_up(int v, int m) {
+  return (v + m - 1) / m * m;
+}
 
 }  // namespace
 
 bool DenseTransform::vectorised() {
+#ifdef FSI_DENSE_AVX2
   static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
   return avx2;
+#else
+  return false;
+#endif
 }
 
-bool DenseTransform::preferred(fftw_r2r_kind kind, int n, int lines, const fftw_plan p) {
-  if (!vectorised() || n < 2 || lines < 1 || !p) return false;
+bool DenseTransform::preferred(fftw_r2r_kind kind, int n) {
+  if (!vectorised() || n < 2) return false;
+  constexpr int kLines = 16;  // FFTW's plan for 16 contiguous lines: its flops per line
+  double* buf = fftw_alloc_real(static_cast<std::size_t>(n) * kLines);
+  const int dims[1] = {n};
+  fftw_r2r_kind k[1] = {kind};
+  fftw_plan p =
+      fftw_plan_many_r2r(1, dims, kLines, buf, nullptr, 1, n, buf, nullptr, 1, n, k, FFTW_ESTIMATE);
   double add = 0, mul = 0, fma = 0;
-  fftw_flops(p, &add, &mul, &fma);
-  const double fftw_per_line = (add + mul + 2 * fma) / lines;
+  if (p) fftw_flops(p, &add, &mul, &fma);
+  if (p) fftw_destroy_plan(p);
+  fftw_free(buf);
+  if (!p) return false;
+  const double fftw_per_line = (add + mul + 2 * fma) / kLines;
   return 2 * fmas_estimate(kind, n) < kAdvantage * fftw_per_line;
 }
 
@@ -168,10 +186,14 @@ std::vector<double> DenseTransform::matrix(fftw_r2r_kind kind, int n) {
           break;
         case FFTW_HC2R:
           // Row k is output index k; column j the halfcomplex entry.
-          if (j == 0) v = 1;
-          else if (2 * j < N) v = 2 * cos_pi(2 * k * j, N);
-          else if (2 * j == N) v = cos_pi(k * j * 2, N);
-          else v = -2 * sin_pi(2 * k * (N - j), N);
+          if (j == 0)
+            v = 1;
+          else if (2 * j < N)
+            v = 2 * cos_pi(2 * k * j, N);
+          else if (2 * j == N)
+            v = cos_pi(k * j * 2, N);
+          else
+            v = -2 * sin_pi(2 * k * (N - j), N);
           break;
         default:
           fsi::fail("fluid::DenseTransform: FFTW kind {} has no matrix here", int(kind));
@@ -181,9 +203,14 @@ std::vector<double> DenseTransform::matrix(fftw_r2r_kind kind, int n) {
   return c;
 }
 
-DenseTransform::DenseTransform(fftw_r2r_kind kind, int n, int lines)
-    : m_n(n), m_lines(lines), m_stride(round_up(std::max(lines, 1), 8)) {
-  if (lines < 1) fsi::fail("fluid::DenseTransform: {} lines", lines);
+DenseTransform::DenseTransform(fftw_r2r_kind kind, int n, int lines, int dist, Kernel kernel)
+    : m_n(n),
+      m_lines(lines),
+      m_dist(dist),
+      m_stride(round_up(std::max(lines, 1), 8)),
+      m_vector_kernel(kernel == Kernel::best && vectorised()) {
+  if (n < 2 || lines < 1 || dist < n)
+    fsi::fail("fluid::DenseTransform: {} lines of length {}, {} apart", lines, n, dist);
   const std::vector<double> c = matrix(kind, n);
   const auto at = [&](int k, int j) { return c[static_cast<std::size_t>(k) * n + j]; };
   double cmax = 0;
@@ -254,7 +281,7 @@ DenseTransform::DenseTransform(fftw_r2r_kind kind, int n, int lines)
 void DenseTransform::gather(const double* x) {
   const int n = m_n, st = m_stride;
   for (int l = 0; l < m_lines; ++l) {
-    const double* xl = x + static_cast<std::size_t>(l) * n;
+    const double* xl = x + static_cast<std::size_t>(l) * m_dist;
     switch (m_sym) {
       case Symmetry::rows: {
         double* sp = m_block[0].s.data() + l;
@@ -268,8 +295,9 @@ void DenseTransform::gather(const double* x) {
       }
       case Symmetry::columns:
         for (int g = 0; g < 2; ++g) {
-          double* s = m_block[g].s.data() + l;
           const std::vector<int>& cols = m_index[g];
+          if (cols.empty()) continue;  // no storage to point into
+          double* s = m_block[g].s.data() + l;
           for (std::size_t q = 0; q < cols.size(); ++q) s[q * st] = xl[cols[q]];
         }
         break;
@@ -285,12 +313,13 @@ void DenseTransform::gather(const double* x) {
 void DenseTransform::scatter(double* x) const {
   const int n = m_n, st = m_stride;
   for (int l = 0; l < m_lines; ++l) {
-    double* xl = x + static_cast<std::size_t>(l) * n;
+    double* xl = x + static_cast<std::size_t>(l) * m_dist;
     switch (m_sym) {
       case Symmetry::rows:
         for (int g = 0; g < 2; ++g) {
-          const double* y = m_block[g].y.data() + l;
           const std::vector<int>& rows = m_index[g];
+          if (rows.empty()) continue;  // no storage to point into
+          const double* y = m_block[g].y.data() + l;
           for (std::size_t r = 0; r < rows.size(); ++r) xl[rows[r]] = y[r * st];
         }
         break;
@@ -318,7 +347,11 @@ void DenseTransform::scatter(double* x) const {
 
 void DenseTransform::apply(double* x) {
   gather(x);
-  const auto product = vectorised() ? product_avx2 : product_plain;
+#ifdef FSI_DENSE_AVX2
+  const auto product = m_vector_kernel ? product_avx2 : product_plain;
+#else
+  const auto product = product_plain;
+#endif
   for (Block& b : m_block)
     if (b.rows > 0 && b.cols > 0)
       product(b.c.data(), round_up(b.rows, 4), b.cols, b.s.data(), m_stride, b.y.data());

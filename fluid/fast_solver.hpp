@@ -79,7 +79,7 @@ class FastSolver {
   void tridiagonal();
   void backward();
   void set_mean_weights(const std::vector<double>& w) { m_weights = w; }
-  // The t-transforms are matrix products (DenseTransform), not FFTW's plans.
+  // The forward or the backward t-transform is a matrix product (DenseTransform).
   bool dense() const { return m_dense_fwd || m_dense_bwd; }
 
  private:
@@ -88,7 +88,7 @@ class FastSolver {
   double* m_buf = nullptr;
   fftw_plan m_fwd = nullptr, m_bwd = nullptr;
   // The t-transforms as matrix products where FFTW has only its generic O(n^2) code for the
-  // length (DenseTransform::preferred); null: FFTW's plans.
+  // length (DenseTransform::preferred; not with s periodic, the 2D plan); null: FFTW's plans.
   std::unique_ptr<DenseTransform> m_dense_fwd, m_dense_bwd;
   double m_norm = 1;
   std::vector<double> m_a;                // sub-diagonal per s-row

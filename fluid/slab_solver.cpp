@@ -116,9 +116,20 @@ SlabSolver::SlabSolver(const Operator1D& t, const Operator1D& s, double sigma, i
   m_lt = eigenvalues(m_nt, t.h, t.lo, t.hi);
   m_norm = kt.norm;
   int stride;  // the local wavenumbers' count in the layout of the solve along s
+  // The t-transforms as FastSolver takes them (FFTW's plan or the matrix product; each line's
+  // result is the same either way on any split), on this rank's t-lines.
+  auto t_lines = [&](int count, int dist, double* p) {
+    m_t_lines = p;
+    m_t_fwd = lines_plan(m_nt, count, p, 1, dist, kt.fwd);
+    m_t_bwd = lines_plan(m_nt, count, p, 1, dist, kt.bwd);
+    if (count <= 0) return;
+    if (DenseTransform::preferred(kt.fwd, m_nt))
+      m_dense_fwd = std::make_unique<DenseTransform>(kt.fwd, m_nt, count, dist);
+    if (DenseTransform::preferred(kt.bwd, m_nt))
+      m_dense_bwd = std::make_unique<DenseTransform>(kt.bwd, m_nt, count, dist);
+  };
   if (t_axis == 0) {
-    m_t_fwd = lines_plan(m_nt, nloc, m_buf, 1, m_nt, kt.fwd);
-    m_t_bwd = lines_plan(m_nt, nloc, m_buf, 1, m_nt, kt.bwd);
+    t_lines(nloc, m_nt, m_buf);
     m_to_lines = transpose_plan(rows, m_nt, m_split.block, bcol, m_buf, comm,
                                 FFTW_MPI_TRANSPOSED_OUT);
     m_from_lines = transpose_plan(m_nt, rows, bcol, m_split.block, m_buf, comm,
@@ -128,8 +139,7 @@ SlabSolver::SlabSolver(const Operator1D& t, const Operator1D& s, double sigma, i
     stride = m_nk;
   } else {
     m_to_y = transpose_plan(rows, m_ns, m_split.block, bcol, m_buf, comm, 0);
-    m_t_fwd = lines_plan(m_nt, c1 - c0, m_buf + pad, 1, rows, kt.fwd);
-    m_t_bwd = lines_plan(m_nt, c1 - c0, m_buf + pad, 1, rows, kt.bwd);
+    t_lines(c1 - c0, rows, m_buf + pad);
     m_to_lines = transpose_plan(m_ns, rows, bcol, m_split.block, m_buf, comm,
                                 FFTW_MPI_TRANSPOSED_OUT);
     m_from_lines = transpose_plan(rows, m_ns, m_split.block, bcol, m_buf, comm,
@@ -179,20 +189,30 @@ void SlabSolver::transpose(fftw_plan p) {
   m_transpose_bytes += m_bytes_per_transpose;
 }
 
+void SlabSolver::t_forward() {
+  if (m_dense_fwd) m_dense_fwd->apply(m_t_lines);
+  else run(m_t_fwd);
+}
+
+void SlabSolver::t_backward() {
+  if (m_dense_bwd) m_dense_bwd->apply(m_t_lines);
+  else run(m_t_bwd);
+}
+
 void SlabSolver::solve() {
   if (m_t_axis == 0) {
-    run(m_t_fwd);
+    t_forward();
     transpose(m_to_lines);
     lines();
     transpose(m_from_lines);
-    run(m_t_bwd);
+    t_backward();
   } else {
     transpose(m_to_y);
-    run(m_t_fwd);
+    t_forward();
     transpose(m_to_lines);
     lines();
     transpose(m_from_lines);
-    run(m_t_bwd);
+    t_backward();
     transpose(m_from_y);
   }
 }

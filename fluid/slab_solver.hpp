@@ -25,6 +25,7 @@
 #include <fftw3-mpi.h>
 #include <mpi.h>
 
+#include <memory>
 #include <vector>
 
 #include "fast_solver.hpp"
@@ -68,6 +69,8 @@ class SlabSolver {
 
  private:
   void lines();  // step 3 (t = x) or 4 (t = y): per local wavenumber, along s
+  void t_forward();
+  void t_backward();
   void transpose(fftw_plan p);
 
   int m_t_axis, m_pad, m_nx, m_nt, m_ns;
@@ -77,6 +80,8 @@ class SlabSolver {
   double* m_work = nullptr;
   // Local transforms along t and along s (when transformed), forward and backward.
   fftw_plan m_t_fwd = nullptr, m_t_bwd = nullptr, m_s_fwd = nullptr, m_s_bwd = nullptr;
+  std::unique_ptr<DenseTransform> m_dense_fwd, m_dense_bwd;  // see FastSolver
+  double* m_t_lines = nullptr;                                // this rank's first t-line
   // The transposes: to_lines before the solve along s, from_lines after it (t = x); for t = y
   // also the pair around the y transforms.
   fftw_plan m_to_lines = nullptr, m_from_lines = nullptr, m_to_y = nullptr, m_from_y = nullptr;

@@ -2,6 +2,7 @@
 // linearised in every iteration (contact_solve.cpp): assemble the residual and tangent at the
 // iterate, add the contact terms, test convergence, factorise and solve, update the iterate.
 #include <chrono>
+#include <cstring>
 #include <cmath>
 #include <limits>
 
@@ -67,9 +68,10 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
   bool contact_active_or_open = false;  // the last iteration had contact candidates
   const bool had_increment = m_dirichlet_pending;
   // The look-ahead factorised this step's first matrix (factorize_ahead): iteration 0 solves with
-  // it and assembles the residual only. Without coupled iterations (whose velocities enter the
-  // matrix), the first matrix is the one at the step's start: predict() moves no elastic node.
-  const bool ahead = m_ahead_fresh && !m_iteration_velocity;
+  // it and assembles the residual only. That matrix is the first iteration's when predict() moves
+  // no elastic node (it does not), no coupled iteration's velocities enter it, and every body's
+  // root masses in it are the last step's (add_root_mass), which the look-ahead had too.
+  const bool ahead = m_ahead_fresh && !m_iteration_velocity && root_mass_tangent_lagged();
   m_ahead_fresh = false;
   {
     std::vector<const std::vector<double>*> xs;  // self-contact: what each node faced, and where,
@@ -95,6 +97,9 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
                     (ahead || (m_keep_allowed && m_keep_factor && m_contact.empty()))));
     assemble_iterate(c0, dt, time_or_factor, external, it > 0, dx, when, !may_reuse);
     rep.assembly_seconds += seconds_since(t0);
+#ifndef NDEBUG
+    if (it == 0 && may_reuse && ahead) check_ahead_matrix(c0, dt, time_or_factor, external);
+#endif
     const ContactLinearisation contact = linearise_contact(c0, dt, time_or_factor, external);
 
     const double rn = contact.residual.norm();
@@ -107,7 +112,9 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
       break;
     }
     if (it >= st.newton_max_iterations) break;
-    const bool reuse = may_reuse && contact.active == 0 && (it == 0 || rn <= kReuseRatio * previous);
+    // may_reuse had no slot active, and detection activates none: no curvature was added.
+    FSI_ASSERT(!may_reuse || contact.active == 0);
+    const bool reuse = may_reuse && (it == 0 || rn <= kReuseRatio * previous);
     if (!reuse && may_reuse) {
       t0 = clock::now();
       assemble(c0, dt, true, time_or_factor, external);
@@ -219,5 +226,31 @@ void Solver::apply_newton_step(const Eigen::VectorXd& dx) {
     B.sync_positions();
   }
 }
+
+// Every body given root masses this step has the last step's too: the first tangent takes those
+// (add_root_mass), as the look-ahead, which has no current ones, did.
+bool Solver::root_mass_tangent_lagged() const {
+  if (!m_root_mass) return true;
+  for (std::size_t b = 0; b < m_root_mass->size(); ++b)
+    if (!(*m_root_mass)[b].empty() &&
+        (m_root_mass_tangent.size() <= b || m_root_mass_tangent[b].empty()))
+      return false;
+  return true;
+}
+
+#ifndef NDEBUG
+// Debug builds: the matrix iteration 0 would assemble is the look-ahead's bit for bit.
+void Solver::check_ahead_matrix(double c0, double dt, double time_or_factor,
+                                const std::vector<std::vector<double>>* external) {
+  const Eigen::VectorXd residual = m_residual;
+  const double force = m_force_scale, roundoff = m_roundoff_scale, floor = m_matrix_floor;
+  assemble(c0, dt, true, time_or_factor, external);
+  m_residual = residual;  // the same values; kept so that the check changes nothing
+  m_force_scale = force, m_roundoff_scale = roundoff, m_matrix_floor = floor;
+  const auto nnz = static_cast<std::size_t>(m_matrix.nonZeros());
+  FSI_ASSERT(m_factored.size() == nnz &&
+             std::memcmp(m_matrix.valuePtr(), m_factored.data(), nnz * sizeof(double)) == 0);
+}
+#endif
 
 }  // namespace solid

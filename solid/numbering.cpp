@@ -174,6 +174,8 @@ void Solver::build_pattern() {
   }
   m_residual.setZero(m_neq);
   m_factored_valid = false;
+  m_matrix_curved = false;
+  m_ahead_fresh = false;
   if (m_neq > 0) m_linear.analyze(m_matrix);
 }
 

@@ -213,6 +213,7 @@ void Solver::restore_state(const StepState& s) {
   m_contact_force_factor = s.contact_force_factor;
   m_root_mass_tangent = s.root_mass_tangent;
   m_dirichlet_pending = false;
+  m_ahead_fresh = false;  // a look-ahead of another state
 }
 
 const std::vector<double>& Solver::positions(int b) const {
@@ -247,6 +248,7 @@ void Solver::set_positions(int b, const std::vector<double>& x) {
   for (std::size_t d = 0; d < x.size(); ++d)
     if (B.eq[d] >= 0) B.u[d] = x[d] - B.X[d];
   B.sync_positions();
+  m_ahead_fresh = false;  // a look-ahead of another state
 }
 
 }  // namespace solid

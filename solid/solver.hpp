@@ -203,6 +203,11 @@ class Solver {
   void solve_contact(const ContactLinearisation& con, double gap_tol, Eigen::VectorXd& dx);
   void store_contact_forces();
   bool any_contact_active() const;
+  bool root_mass_tangent_lagged() const;
+#ifndef NDEBUG
+  void check_ahead_matrix(double c0, double dt, double time_or_factor,
+                          const std::vector<std::vector<double>>* external);
+#endif
   void factorize(const std::string& when);
   bool factorize_cached();
   // The Newmark step's parts (newmark.cpp).

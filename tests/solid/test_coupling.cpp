@@ -287,6 +287,7 @@ TEST_CASE("open contact candidates keep the look-ahead's factor", "[coupling][co
     b.factorize_ahead(dt);
     iterations += b.advance(dt, &f).iterations;
     REQUIRE(b.min_contact_gap() > 0.02);
+    REQUIRE(b.min_contact_gap() < 0.05);  // within reach: the slots are open candidates
   }
   INFO(a.factorizations() << " and " << b.factorizations() << " factorisations, "
                           << a.factor_reuses() << " and " << b.factor_reuses() << " reuses, "
