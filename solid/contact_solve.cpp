@@ -263,6 +263,7 @@ void Solver::solve_contact(const ContactLinearisation& con, double gap_tol, Eige
     for (int k = 0; k < nc; ++k)
       if (!in_work[k] && gap_after(k, dx) < -gap_tol) work.push_back(k), in_work[k] = 1, grown = true;
     if (!grown) break;
+    ++m_working_set_growths;
   }
   for (auto& s : slots) {
     s.active = false;

@@ -99,6 +99,9 @@ class Solver {
   void factorize_ahead(double dt);
   long factor_reuses() const { return m_factor_reuses; }
   long factorizations() const { return m_factorizations; }
+  // Times a contact working set grew within an iteration (solve_contact): a candidate the free
+  // step left open was taken through by the constrained one.
+  long contact_working_set_growths() const { return m_working_set_growths; }
   // Checkpoints: the values of the matrix whose factor the next step starts with, when it keeps
   // one (empty otherwise); a resumed run factorises them again, so it continues bit for bit.
   KeptFactor kept_factor() const;
@@ -245,6 +248,7 @@ class Solver {
   bool m_factored_valid = false;
   long m_factor_reuses = 0;
   long m_factorizations = 0;
+  long m_working_set_growths = 0;
   // A dynamic step may start with the factor the last one solved with (newton.cpp, kKeepRatio):
   // allowed during advance(), earned by the last step's first contraction.
   bool m_keep_allowed = false;

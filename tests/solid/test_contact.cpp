@@ -517,3 +517,55 @@ TEST_CASE("self-contact: behind a feature by more than it moved is the other sid
   CHECK(slot().m0 == -1);
   CHECK(std::isinf(slot().gap));
 }
+
+// The contact working set's growth (solve_contact): a stiff bar pushed down at its middle, over
+// a fixed rigid block under its left end (near) and a plane under the whole bar (farther). The
+// step without contact moves the bar down as a whole: its left end through the block, the rest
+// short of the plane. Held at the left end, the bar turns about it, and its right end goes down
+// further, through the plane. That end's slot is not in the first working set: the set grows,
+// and the step ends with no slot through, the right end on the plane.
+TEST_CASE("a lever takes a node the free step left open through: the working set grows",
+          "[contact][dynamic]") {
+  // The free step moves the bar by s = 2e-3 (its centre's displacement under the load alone);
+  // the left end stops after 0.2 s, and, turning about it, the right end would go 1.4 s down.
+  const double s_free = 2e-3, g_block = 0.2 * s_free, g_plane = 1.2 * s_free;
+  Model model;
+  model.settings.newton_tolerance = 1e-12;
+  BodySpec b;
+  b.name = "lever";
+  b.mesh = rectangle_mesh(0, 0, 1, 0.1, 20, 2, Diagonals::criss_cross);
+  // Stiff enough to move as a rigid body within the step (its waves cross it in 3e-6, its first
+  // bending period is about 3e-5) and to bend under the load by much less than the gaps.
+  b.materials = {Material::from_young(MaterialModel::neo_hookean, 1e11, 0.3, 1)};
+  BodySpec block;
+  block.name = "block";
+  block.kind = BodyKind::rigid;
+  block.mesh = rectangle_mesh(-0.1, -g_block - 0.1, 0.13, 0.1, 1, 1, Diagonals::right);
+  model.bodies = {b, block};
+  ContactPair on_block;
+  on_block.slave = 0;
+  on_block.master = 1;
+  on_block.two_way = false;
+  model.contacts = {on_block};
+  ContactPlane plane;
+  plane.point = {0, -g_plane};
+  plane.normal = {0, 1};
+  plane.bodies = {0};
+  model.planes = {plane};
+  Solver s(model);
+  const int right = 20;  // the lower edge's right end (node i + 21 j)
+  std::vector<std::vector<double>> f(2);
+  f[0].assign(s.positions(0).size(), 0.0);
+  f[0][2 * 10 + 1] = -400;  // on the lower edge's middle: (F/m) dt^2 / 2 = s_free, m = 0.1
+  const double dt = 1e-3;
+  const auto rep = s.advance(dt, &f);
+  INFO(rep.iterations << " Newton iterations, " << s.contact_working_set_growths()
+                      << " growths, min gap " << s.min_contact_gap() << ", right end moved "
+                      << s.displacements(0)[2 * right + 1]);
+  CHECK(rep.converged);
+  CHECK(s.contact_working_set_growths() >= 1);
+  const double tol = model.settings.contact_tolerance * 0.05;  // times the smallest edge
+  CHECK(s.min_contact_gap() >= -tol);
+  CHECK(s.displacements(0)[2 * right + 1] == Approx(-g_plane).margin(1e-9));
+  CHECK(s.contact_forces(0)[2 * right + 1] > 0);  // the plane pushes the right end up
+}
