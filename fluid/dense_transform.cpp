@@ -135,6 +135,12 @@ bool DenseTransform::preferred(fftw_r2r_kind kind, int n) {
   return 2 * fmas_estimate(kind, n) < kAdvantage * fftw_per_line;
 }
 
+std::unique_ptr<DenseTransform> DenseTransform::if_preferred(fftw_r2r_kind kind, int n,
+                                                             int lines, int dist) {
+  if (lines < 1 || !preferred(kind, n)) return nullptr;
+  return std::make_unique<DenseTransform>(kind, n, lines, dist);
+}
+
 // FFTW's definitions (manual, "What FFTW Really Computes"), j the input index, k the output's:
 //   REDFT00 y_k = x_0 + (-1)^k x_{n-1} + 2 sum_{j=1}^{n-2} x_j cos(pi j k / (n-1))
 //   REDFT10 y_k = 2 sum x_j cos(pi (j+1/2) k / n)

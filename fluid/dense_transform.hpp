@@ -8,6 +8,7 @@
 
 #include <fftw3.h>
 
+#include <memory>
 #include <vector>
 
 namespace fluid {
@@ -32,6 +33,9 @@ class DenseTransform {
   // kernel, and when its flops are under kAdvantage times those of FFTW's plan for contiguous
   // lines (a fixed plan, so every caller, on any rank, decides alike).
   static bool preferred(fftw_r2r_kind kind, int n);
+  // The transform for these lines when it is preferred, else null (FFTW's plan serves them).
+  static std::unique_ptr<DenseTransform> if_preferred(fftw_r2r_kind kind, int n, int lines,
+                                                      int dist);
 
  private:
   // How C's symmetry under index reversal r(i) = n - 1 - i halves the product:

@@ -133,10 +133,8 @@ FastSolver::FastSolver(const Operator1D& t, const Operator1D& s, double sigma)
     m_bwd = fftw_plan_many_r2r(1, n, m_ns, m_buf, nullptr, 1, m_nt, m_buf, nullptr, 1, m_nt, kb,
                                FFTW_ESTIMATE);
     m_norm = kt.norm;
-    if (DenseTransform::preferred(kt.fwd, m_nt))
-      m_dense_fwd = std::make_unique<DenseTransform>(kt.fwd, m_nt, m_ns, m_nt);
-    if (DenseTransform::preferred(kt.bwd, m_nt))
-      m_dense_bwd = std::make_unique<DenseTransform>(kt.bwd, m_nt, m_ns, m_nt);
+    m_dense_fwd = DenseTransform::if_preferred(kt.fwd, m_nt, m_ns, m_nt);
+    m_dense_bwd = DenseTransform::if_preferred(kt.bwd, m_nt, m_ns, m_nt);
     // Thomas factors of (a, b + lambda_k - sigma, c) for every wavenumber k; the
     // normalisation of the transform pair is folded into the first pivot's right-hand side.
     m_a = s.a;

@@ -122,11 +122,8 @@ SlabSolver::SlabSolver(const Operator1D& t, const Operator1D& s, double sigma, i
     m_t_lines = p;
     m_t_fwd = lines_plan(m_nt, count, p, 1, dist, kt.fwd);
     m_t_bwd = lines_plan(m_nt, count, p, 1, dist, kt.bwd);
-    if (count <= 0) return;
-    if (DenseTransform::preferred(kt.fwd, m_nt))
-      m_dense_fwd = std::make_unique<DenseTransform>(kt.fwd, m_nt, count, dist);
-    if (DenseTransform::preferred(kt.bwd, m_nt))
-      m_dense_bwd = std::make_unique<DenseTransform>(kt.bwd, m_nt, count, dist);
+    m_dense_fwd = DenseTransform::if_preferred(kt.fwd, m_nt, count, dist);
+    m_dense_bwd = DenseTransform::if_preferred(kt.bwd, m_nt, count, dist);
   };
   if (t_axis == 0) {
     t_lines(nloc, m_nt, m_buf);
