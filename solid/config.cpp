@@ -282,6 +282,11 @@ Config read_config(const fsi::SceneTable& s, double fluid_density) {
   st.newton_tolerance = s.positive("newton_tolerance", defaults.newton_tolerance);
   st.newton_max_iterations = static_cast<int>(
       s.positive_integer("newton_max_iterations", defaults.newton_max_iterations));
+  const long cutbacks = s.integer("step_cutbacks", defaults.step_cutbacks);
+  if (cutbacks < 0 || cutbacks > kMaxStepCutbacks)
+    s.fail("step_cutbacks",
+           fmt::format("must be in [0, {}], got {}", kMaxStepCutbacks, cutbacks));
+  st.step_cutbacks = static_cast<int>(cutbacks);
   st.contact_tolerance = s.positive("contact_tolerance", defaults.contact_tolerance);
   st.keep_factor = s.boolean("keep_factor", defaults.keep_factor);
   c.modes = static_cast<int>(s.integer("modes", 0));

@@ -12,7 +12,7 @@ void Solver::fail_health(const std::string& what, int body, int element,
                          const std::string& when) const {
   const Body& B = *m_bodies[body];
   const auto& t = B.spec.mesh.triangles[element];
-  fsi::fail("{} in body '{}' element {} (nodes {}, {}, {}; det F = {:.4g}) at {}", what,
+  step_failed("{} in body '{}' element {} (nodes {}, {}, {}; det F = {:.4g}) at {}", what,
             B.spec.name, element, t[0], t[1], t[2], B.det_f[element], when);
 }
 
@@ -21,7 +21,7 @@ void Solver::check_finite(const std::string& when) const {
     const Body& B = *bp;
     for (std::size_t d = 0; d < B.x.size(); ++d)
       if (!std::isfinite(B.x[d]) || !std::isfinite(B.v[d]))
-        fsi::fail("non-finite {} in body '{}' node {} at {}",
+        step_failed("non-finite {} in body '{}' node {} at {}",
                   std::isfinite(B.x[d]) ? "velocity" : "position", B.spec.name, d / 2, when);
   }
 }
@@ -45,9 +45,9 @@ void Solver::fail_non_finite_residual(std::pair<int, int> inverted, const std::s
   for (const auto& bp : m_bodies)
     for (std::size_t d = 0; d < bp->r.size(); ++d)
       if (bp->is_elastic() && bp->eq[d] >= 0 && !std::isfinite(bp->r[d]))
-        fsi::fail("non-finite residual (NaN or Inf) in body '{}' node {} at {}",
+        step_failed("non-finite residual (NaN or Inf) in body '{}' node {} at {}",
                   bp->spec.name, d / 2, when);
-  fsi::fail("non-finite residual (NaN or Inf) at {}", when);
+  step_failed("non-finite residual (NaN or Inf) at {}", when);
 }
 
 // Newton at its iteration limit. Names the node with the largest residual: that of the assembled
@@ -63,7 +63,7 @@ void Solver::fail_not_converged(const StepReport& rep, const std::string& when) 
         wb = bp->index;
         wn = static_cast<int>(d / 2);
       }
-  fsi::fail(
+  step_failed(
       "Newton did not converge in {} iterations at {}: residual {:.3e}, tolerance "
       "{:.3e}, {} active contacts; largest residual in body '{}' node {}",
       rep.iterations, when, rep.residuals.back(), rep.tolerance, rep.active_contacts,

@@ -91,6 +91,10 @@ struct ContactPlane {
 
 enum class Analysis { dynamic, statics };
 
+// Halvings of a failed step at most (Settings::step_cutbacks): a step of dt / 2^20 is far below
+// any time scale a scene resolves.
+constexpr int kMaxStepCutbacks = 20;
+
 struct Settings {
   Analysis analysis = Analysis::dynamic;
   int load_steps = 1;        // static analysis
@@ -98,6 +102,9 @@ struct Settings {
   Vec2 gravity{0, 0};
   double newton_tolerance = 1e-10;  // on ||R|| relative to the force scale
   int newton_max_iterations = 30;
+  // A dynamic step that fails (Newton, det F <= 0, not finite) is taken again as two half steps,
+  // each of which may be halved again, at most this many times (down to dt / 2^step_cutbacks).
+  int step_cutbacks = 3;
   double contact_tolerance = 1e-10;  // on the gap, relative to the smallest element edge
   bool keep_factor = true;  // a dynamic step may start with the last step's factor (newton.cpp)
 };

@@ -1,6 +1,8 @@
 // The Newmark step (beta = 1/4, gamma = 1/2, the trapezoidal rule): the predictor, Newton on the
 // step's residual with contact (newton.cpp), the velocity and acceleration update; and the
 // look-ahead factorisation of the next step's first matrix.
+#include <cstdio>
+
 #include "error.hpp"
 #include "solver_body.hpp"
 
@@ -12,6 +14,8 @@ namespace {
 // trapezoidal residual, in which a force acting over the step enters with weight 2 (as the
 // coupling force does, assembly.cpp): the force on the bodies is lambda / 2.
 constexpr double kNewmarkContactForceFactor = 0.5;
+// Cut-back steps announced on stderr; later ones are only counted (Solver::cut_steps).
+constexpr long kCutbackNotes = 10;
 
 }  // namespace
 
@@ -38,6 +42,9 @@ void Solver::factorize_ahead(double dt) {
 // One step t^n -> t^(n+1) = t^n + dt:
 //   R(x) = F(t^(n+1)) - Q(x) - (4/dt^2) M (x - x^n - dt v^n) + (M a)^n + 2 F_c,
 // R(x^(n+1)) + B^T lambda = 0 with the contact conditions, then the trapezoidal update.
+// A step that fails (StepFailed) is taken again from its start as two steps of dt/2 with the
+// same external forces, each of which may be halved again, settings.step_cutbacks times at most
+// (newmark_span); the step then ends at t^(n+1) as one step does.
 StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* external,
                            const std::vector<std::vector<double>>* iteration_velocity,
                            const std::vector<std::vector<double>>* root_mass) {
@@ -54,8 +61,6 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
   const double t1 = m_time + dt;
   const std::string when = fmt::format("step {} (t = {:.6g})", m_step + 1, t1);
   if (m_step == 0 && m_time == 0) initial_acceleration(dt);
-  predict(t1);
-  m_contact_force_factor = kNewmarkContactForceFactor;
   // Coupled iterations: the fluid's reaction is linearised about the coupler's velocity
   // (assembly.cpp); without a fluid there is no reaction to linearise.
   m_iteration_velocity = m_model.settings.fluid_density > 0 ? iteration_velocity : nullptr;
@@ -63,8 +68,11 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
   StepReport rep;
   m_keep_allowed = m_model.settings.keep_factor && m_keep_permitted;
   if (!m_keep_allowed) m_keep_factor = false;
+  // The linearised reaction of coupled iterations is about the velocity at t^(n+1): a step that
+  // carries it is not cut.
+  const int cutbacks = m_iteration_velocity ? 0 : m_model.settings.step_cutbacks;
   try {
-    rep = newton(newmark_c0(dt), dt, t1, external, when);
+    rep = newmark_span(dt, external, when, cutbacks, 1);
   } catch (...) {
     m_iteration_velocity = nullptr;
     m_root_mass = nullptr;
@@ -74,11 +82,62 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
   m_iteration_velocity = nullptr;
   m_root_mass = nullptr;
   m_keep_allowed = false;
-  // The next step's tangent (and its look-ahead factorisation) takes this step's root masses.
-  m_root_mass_tangent = root_mass ? *root_mass : std::vector<std::vector<double>>{};
-  update_velocity(dt);
   m_time = t1;
   m_step++;
+  if (rep.substeps > 1) m_cut_steps++;
+  return rep;
+}
+
+// One Newmark step of dt from the current state, or, when it fails and `cutbacks` > 0, two
+// steps of dt/2 from the same start (each a span with one cutback less). `parts`: how many such
+// steps the caller's step is cut into at this depth (1 for the whole step), for the messages.
+// The contact forces left on the bodies are the mean over the span's steps: each is the force
+// over its own step (Newmark: lambda / 2 acts over the step, Eq. 13-14), so the mean has the
+// span's impulse.
+StepReport Solver::newmark_span(double dt, const std::vector<std::vector<double>>* external,
+                                const std::string& when, int cutbacks, int parts) {
+  StepState start;
+  if (cutbacks > 0) save_state(start);
+  const std::string here =
+      parts == 1 ? when : fmt::format("{}, cut into steps of dt/{} (this one from t = {:.9g})",
+                                      when, parts, m_time);
+  try {
+    return newmark_step(dt, external, here);
+  } catch (const StepFailed& e) {
+    if (cutbacks == 0) throw;
+    if (m_cutback_notes++ < kCutbackNotes) {
+      const std::string what = e.what();
+      std::fprintf(stderr, "[solid] note: %s; taken again as two steps of dt/%d\n",
+                   what.substr(0, what.find('\n')).c_str(), 2 * parts);
+    }
+  }
+  restore_state(start);
+  StepReport first = newmark_span(dt / 2, external, when, cutbacks - 1, 2 * parts);
+  std::vector<std::vector<double>> contact;
+  for (const auto& b : m_bodies) contact.push_back(b->contact);
+  StepReport rep = newmark_span(dt / 2, external, when, cutbacks - 1, 2 * parts);
+  for (std::size_t b = 0; b < m_bodies.size(); ++b)
+    for (std::size_t d = 0; d < contact[b].size(); ++d)
+      m_bodies[b]->contact[d] = 0.5 * (contact[b][d] + m_bodies[b]->contact[d]);
+  rep.iterations += first.iterations;
+  rep.assembly_seconds += first.assembly_seconds;
+  rep.factor_seconds += first.factor_seconds;
+  rep.solve_seconds += first.solve_seconds;
+  rep.substeps += first.substeps;
+  return rep;
+}
+
+// One Newmark step of dt from the current state, the clock moved to its end.
+StepReport Solver::newmark_step(double dt, const std::vector<std::vector<double>>* external,
+                                const std::string& when) {
+  const double t1 = m_time + dt;
+  predict(t1);
+  m_contact_force_factor = kNewmarkContactForceFactor;
+  StepReport rep = newton(newmark_c0(dt), dt, t1, external, when);
+  // The next step's tangent (and its look-ahead factorisation) takes this step's root masses.
+  m_root_mass_tangent = m_root_mass ? *m_root_mass : std::vector<std::vector<double>>{};
+  update_velocity(dt);
+  m_time = t1;
   check_finite(when);
   check_inverted(when);
   return rep;

@@ -171,7 +171,7 @@ void Solver::fail_contact_not_converged(const StepReport& rep, const std::string
   const auto& r = rep.residuals;
   for (std::size_t k = r.size() > kResidualsNamed ? r.size() - kResidualsNamed : 0; k < r.size(); ++k)
     history += fmt::format("{}{:.3e}", history.empty() ? "" : ", ", r[k]);
-  fsi::fail(
+  step_failed(
       "Newton did not converge in {} iterations at {} with contact: residual {:.3e} (the last "
       "iterations: {}), tolerance {:.3e}, accepted gap {:.3e}; {} active "
       "and penetrating contacts{}{}\nChange: solid.newton_max_iterations (now {}), "

@@ -303,6 +303,7 @@ nlohmann::json SolidProgram::report() const {
   j["equations"] = s.num_equations();
   j["steps"] = m_steps;
   if (m_repeats > 0) j["repeated_steps"] = m_repeats;
+  j["cut_steps"] = s.cut_steps();  // failed whole, taken in halves (step_cutbacks)
   j["newton_iterations"] = m_newton_total;
   j["newton_iterations_max"] = m_newton_max;
   j["phases"] = {{"assembly", m_assembly}, {"factorization", m_factor}, {"solve", m_solve}};

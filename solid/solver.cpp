@@ -19,6 +19,9 @@ Solver::Solver(Model model, LinearSolver::Backend backend)
   const auto& s = m_model.settings;
   if (!(s.newton_tolerance > 0)) throw fsi::InputError("newton tolerance must be > 0");
   if (s.newton_max_iterations < 1) throw fsi::InputError("newton iterations must be >= 1");
+  if (s.step_cutbacks < 0 || s.step_cutbacks > kMaxStepCutbacks)
+    throw fsi::InputError(fmt::format("step cutbacks must be in [0, {}], got {}",
+                                      kMaxStepCutbacks, s.step_cutbacks));
   if (s.analysis == Analysis::statics && s.load_steps < 1)
     throw fsi::InputError("load_steps must be >= 1");
   for (std::size_t b = 0; b < m_model.bodies.size(); ++b) {

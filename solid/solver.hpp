@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "contact.hpp"
+#include "error.hpp"
 #include "element.hpp"
 #include "linear_solver.hpp"
 #include "model.hpp"
@@ -29,7 +30,21 @@ struct StepReport {
   bool converged = false;
   int active_contacts = 0;
   double assembly_seconds = 0, factor_seconds = 0, solve_seconds = 0;
+  int substeps = 1;  // Newmark steps the step took (more than one after a cutback)
 };
+
+// A step the solver could not take: Newton did not converge, an element turned inside out, the
+// state or the residual is not finite. advance() redoes such a step in halves
+// (Settings::step_cutbacks) before it gives up.
+class StepFailed : public fsi::Error {
+ public:
+  using fsi::Error::Error;
+};
+
+template <class... Args>
+[[noreturn]] void step_failed(fmt::format_string<Args...> f, Args&&... args) {
+  throw StepFailed(fmt::format(f, std::forward<Args>(args)...));
+}
 
 // Eigenmodes of K phi = omega^2 M phi about the reference state (paper Eq. 28).
 struct Modes {
@@ -98,6 +113,8 @@ class Solver {
   // matrix is left for the step to report.
   void factorize_ahead(double dt);
   long factor_reuses() const { return m_factor_reuses; }
+  // Steps that failed whole and were taken in halves (settings.step_cutbacks).
+  long cut_steps() const { return m_cut_steps; }
   long factorizations() const { return m_factorizations; }
   // Times a contact working set grew within an iteration (solve_contact): a candidate the free
   // step left open was taken through by the constrained one.
@@ -216,6 +233,10 @@ class Solver {
   // The Newmark step's parts (newmark.cpp).
   void initial_acceleration(double dt);
   void predict(double t1);
+  StepReport newmark_span(double dt, const std::vector<std::vector<double>>* external,
+                          const std::string& when, int cutbacks, int parts);
+  StepReport newmark_step(double dt, const std::vector<std::vector<double>>* external,
+                          const std::string& when);
   void update_velocity(double dt);
   // u_old, v_old := u, v: the state the coming step starts from.
   void keep_step_start();
@@ -249,6 +270,7 @@ class Solver {
   long m_factor_reuses = 0;
   long m_factorizations = 0;
   long m_working_set_growths = 0;
+  long m_cut_steps = 0, m_cutback_notes = 0;  // advance(): steps cut back, notes printed
   // A dynamic step may start with the factor the last one solved with (newton.cpp, kKeepRatio):
   // allowed during advance(), earned by the last step's first contraction.
   bool m_keep_allowed = false;

@@ -112,6 +112,21 @@ bodies = ["floor", "bar"]
   CHECK(s.num_equations() > 0);
 }
 
+TEST_CASE("step_cutbacks: the default, a value, and out of range", "[config][input]") {
+  const std::string mat = "density = 1\nyoungs_modulus = 1\npoisson_ratio = 0.3\n";
+  CHECK(read("cut_default.toml", with_material(mat)).model.settings.step_cutbacks == 3);
+  std::string text = with_material(mat);
+  text.replace(text.find("[solid]\n"), 8, "[solid]\nstep_cutbacks = 0\n");
+  CHECK(read("cut_zero.toml", text).model.settings.step_cutbacks == 0);
+  text.replace(text.find("step_cutbacks = 0"), 17, "step_cutbacks = 21");
+  CHECK_THROWS_WITH(read("cut_many.toml", text), Catch::Contains("solid.step_cutbacks") &&
+                                                     Catch::Contains("got 21") &&
+                                                     Catch::Contains("cut_many.toml"));
+  text.replace(text.find("step_cutbacks = 21"), 18, "step_cutbacks = -1");
+  CHECK_THROWS_WITH(read("cut_negative.toml", text),
+                    Catch::Contains("solid.step_cutbacks") && Catch::Contains("got -1"));
+}
+
 TEST_CASE("bad elastic constants name the key, the value and the file", "[config][input]") {
   CHECK_THROWS_WITH(
       read("nu_half.toml", with_material("density = 1\nyoungs_modulus = 1\npoisson_ratio = 0.5\n")),

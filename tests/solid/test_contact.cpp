@@ -148,6 +148,75 @@ TEST_CASE("a block dropped on a rigid plane bounces without penetration or energ
   CHECK(max_vy_after > 0.1 * -min_vy);  // it comes back up
 }
 
+namespace {
+
+// The dropped block of the test above, Newton allowed `iterations`, failed steps halved
+// `cutbacks` times.
+Model dropped_block(int iterations, int cutbacks) {
+  Model model;
+  model.settings.gravity = {0, -10};
+  model.settings.newton_tolerance = 1e-12;
+  model.settings.newton_max_iterations = iterations;
+  model.settings.step_cutbacks = cutbacks;
+  BodySpec b;
+  b.name = "block";
+  b.mesh = rectangle_mesh(0, 0.05, 0.4, 0.2, 8, 4, Diagonals::criss_cross);
+  b.materials = {Material::from_young(MaterialModel::neo_hookean, 2e4, 0.3, 10)};
+  model.bodies = {b};
+  ContactPlane plane;
+  plane.point = {0, 0};
+  plane.normal = {0, 1};
+  plane.bodies = {0};
+  model.planes = {plane};
+  return model;
+}
+
+}  // namespace
+
+TEST_CASE("a step that fails whole is taken as two half steps, with their mean contact force",
+          "[contact][dynamic]") {
+  // With 4 Newton iterations some steps of 4e-3 fail (Newton converges, but not within 4),
+  // among them steps in contact; their halves do not.
+  constexpr int kIterations = 4;
+  constexpr double kDt = 4e-3;
+  auto upward = [](const std::vector<double>& f) {
+    double sum = 0;
+    for (std::size_t d = 1; d < f.size(); d += 2) sum += f[d];
+    return sum;
+  };
+  // The first step cut in two while the block presses on the plane.
+  Solver cut(dropped_block(kIterations, 3));
+  int first_cut = -1, cut_in_contact = -1;
+  for (int k = 0; k < 300 && cut_in_contact < 0; ++k) {
+    const StepReport rep = cut.advance(kDt);
+    if (rep.substeps > 1 && first_cut < 0) first_cut = k;
+    if (rep.substeps == 2 && upward(cut.contact_forces(0)) > 0) cut_in_contact = k;
+  }
+  REQUIRE(cut_in_contact >= 0);
+  CHECK(cut.step() == cut_in_contact + 1);
+  CHECK(cut.time() == Approx((cut_in_contact + 1) * kDt).epsilon(1e-14));
+  // Without cutbacks the run stops at the first of them.
+  Solver plain(dropped_block(kIterations, 0));
+  for (int k = 0; k < first_cut; ++k) plain.advance(kDt);
+  CHECK_THROWS_AS(plain.advance(kDt), StepFailed);
+  // The reference: the same steps, then two steps of kDt / 2 taken as such.
+  Solver halves(dropped_block(kIterations, 3));
+  for (int k = 0; k < cut_in_contact; ++k) halves.advance(kDt);
+  CHECK(halves.advance(kDt / 2).substeps == 1);
+  const std::vector<double> first_force = halves.contact_forces(0);
+  CHECK(halves.advance(kDt / 2).substeps == 1);
+  const std::vector<double> second_force = halves.contact_forces(0);
+  CHECK(cut.positions(0) == halves.positions(0));
+  CHECK(cut.velocities(0) == halves.velocities(0));
+  const std::vector<double> force = cut.contact_forces(0);
+  for (std::size_t d = 0; d < force.size(); ++d)
+    CHECK(force[d] == Approx(0.5 * (first_force[d] + second_force[d])).margin(1e-12));
+  CHECK(halves.cut_steps() == cut.cut_steps() - 1);
+  // And the run goes on from there, on the plane.
+  for (int k = 0; k < 20; ++k) cut.advance(kDt);
+  CHECK(cut.min_contact_gap() >= -1e-8 * 0.4);
+}
+
 TEST_CASE("the segment gap Hessian is the derivative of the gap gradient", "[contact]") {
   // g(x) = (x_s - x_1) . n(x_2 - x_1); gradient (n, -(1 - xi) n, -xi n).
   auto gradient = [](const double* x, double* grad) {
@@ -489,6 +558,7 @@ TEST_CASE("self-contact: two nodes at each other's vertex are one contact",
   CHECK(slot(a).m1 >= 0);
   CHECK(slot(a).normal[0] == Approx(-1.0));
 }
+
 
 // A node behind a feature it did not face at the step's start counts as having gone through it
 // only as deep as it and the feature moved since (twice that): deeper, it is the body's other
