@@ -48,7 +48,8 @@ void SolidProgram::save(fsi::H5File& h5) const {
   fsi::write_vectors(h5, "solid/root_mass_tangent", s.root_mass_tangent);
   h5.write("solid/slots", slots_to_numbers(s.slots));
   h5.write("solid/clock", std::vector<double>{s.time, s.contact_force_factor});
-  h5.write("solid/counts", std::vector<std::int64_t>{s.step, m_steps, m_repeats, m_newton_total, m_newton_max});
+  h5.write("solid/counts", std::vector<std::int64_t>{s.step, m_steps, m_repeats, m_newton_total,
+                                                     m_newton_max, m_cut_steps});
   h5.write("solid/t_end", std::vector<double>{m_rt.settings().t_end});
   h5.write("solid/contact_entries", m_solver->contact_entries());
   const KeptFactor k = m_solver->kept_factor();
@@ -77,6 +78,7 @@ void SolidProgram::load(const fsi::H5File& h5) {
   const auto counts = h5.read_int64s("solid/counts");
   s.step = counts.at(0), m_steps = counts.at(1), m_repeats = counts.at(2);
   m_newton_total = counts.at(3), m_newton_max = counts.at(4);
+  m_cut_steps = counts.size() > 5 ? counts[5] : 0;  // (checkpoints before step_cutbacks: none)
   m_solver->restore_state(s);
   if (h5.exists("solid/contact_entries"))
     m_solver->restore_contact_entries(h5.read_int64s("solid/contact_entries"));

@@ -30,11 +30,6 @@ constexpr double kSelfSearch = 4;
 // the vertex is already its feature) touches the vertex, with the vertex's pseudo-normal as the
 // gap's gradient (detect_self).
 constexpr double kSelfVertexZone = 0.01;
-// Self-contact: node b on an edge that ends at node a, within this fraction of a reach (the
-// body's smallest surface edge) of a, while a has b's vertex as its feature, is one contact with
-// a (join_vertex_pairs). Relative to the reach, not to the edge: a stretched edge does not widen
-// it.
-constexpr double kSelfJoinNear = 0.05;
 // Self-contact: a node behind a feature it did not face at the step's start is the body's other
 // side unless it is within this many times its motion since, relative to the feature's point
 // under it (plus the accepted gap, at least kKeepEdge reaches; at most one reach).
@@ -197,7 +192,7 @@ void ContactSet::detect(const std::vector<const std::vector<double>*>& x,
     }
   }
   for (auto& s : m_slots) detect_slot(s, x, boxes, reach[s.slave_body]);
-  join_vertex_pairs(x, reach);
+  join_vertex_pairs(x);
 }
 
 // Two nodes a and b of one surface, each at the other's vertex (a curled fold's two shoulders
@@ -210,13 +205,7 @@ void ContactSet::detect(const std::vector<const std::vector<double>*>& x,
 // -n), and the gap (a - b) . n: the same constraint twice, which the complementarity solve
 // handles as any two slots on one contact (it keeps one), and the nodes may slide along each
 // other.
-//
-// The same holds when b's feature is not a's vertex but an edge that ends at a, with b's point on
-// it within kSelfJoinNear reaches of a (a fold's crease closing: b a hair off a,
-// on the edge beside it, while a finds b as its vertex): b's feature becomes a's vertex and the
-// two are joined the same way, b's normal taken as that of the edge.
-void ContactSet::join_vertex_pairs(const std::vector<const std::vector<double>*>& x,
-                                   const std::vector<double>& reach) {
+void ContactSet::join_vertex_pairs(const std::vector<const std::vector<double>*>& x) {
   for (std::size_t b = 0; b < m_self_slot.size(); ++b) {
     const auto& index = m_self_slot[b];
     if (index.empty()) continue;
@@ -228,30 +217,18 @@ void ContactSet::join_vertex_pairs(const std::vector<const std::vector<double>*>
       const int kb = index[sa.m0];
       if (kb <= ka) continue;  // each pair once
       ContactSlot& sb = m_slots[kb];
-      const int a = sa.slave_node, v = sb.slave_node;
-      if (sb.m1 < 0 ? sb.m0 != a : !near_end_of_edge(sb, a, xb, kSelfJoinNear * reach[b]))
-        continue;
+      if (sb.m0 != sa.slave_node || sb.m1 >= 0) continue;
       Vec2 n{sa.normal[0] - sb.normal[0], sa.normal[1] - sb.normal[1]};
       const double ln = std::hypot(n[0], n[1]);
       if (!(ln > 1e-6)) continue;  // normals that cancel: no common direction
       n = {n[0] / ln, n[1] / ln};
+      const int a = sa.slave_node, v = sb.slave_node;
       const double g = (xb[2 * a] - xb[2 * v]) * n[0] + (xb[2 * a + 1] - xb[2 * v + 1]) * n[1];
       sa.normal = n;
       sb.normal = {-n[0], -n[1]};
       sa.gap = sb.gap = g;
-      sb.m0 = a, sb.m1 = -1, sb.xi = 0;  // a's vertex, so that both rows of B are one constraint
     }
   }
-}
-
-// Slot s's feature is an edge that ends at node a, and s's point on it lies within `near` of a
-// (x: the body's positions).
-bool ContactSet::near_end_of_edge(const ContactSlot& s, int a, const std::vector<double>& x,
-                                  double near) {
-  if (s.m1 < 0 || (s.m0 != a && s.m1 != a)) return false;
-  const double ex = x[2 * s.m1] - x[2 * s.m0], ey = x[2 * s.m1 + 1] - x[2 * s.m0 + 1];
-  const double px = x[2 * s.m0] + s.xi * ex, py = x[2 * s.m0 + 1] + s.xi * ey;
-  return std::hypot(px - x[2 * a], py - x[2 * a + 1]) <= near;
 }
 
 void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector<double>*>& x,

@@ -70,10 +70,7 @@ class ContactSet {
                    const std::vector<std::array<double, 4>>& boxes, double reach) const;
   void detect_self(ContactSlot& s, const std::array<int, 2>& front, const std::vector<double>& x,
                    double reach) const;
-  void join_vertex_pairs(const std::vector<const std::vector<double>*>& x,
-                         const std::vector<double>& reach);
-  static bool near_end_of_edge(const ContactSlot& s, int a, const std::vector<double>& x,
-                               double near);
+  void join_vertex_pairs(const std::vector<const std::vector<double>*>& x);
   std::vector<Surface> m_surfaces;
   std::vector<ContactPlane> m_planes;
   std::vector<ContactSlot> m_slots;

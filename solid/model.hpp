@@ -91,9 +91,9 @@ struct ContactPlane {
 
 enum class Analysis { dynamic, statics };
 
-// Halvings of a failed step at most (Settings::step_cutbacks): a step of dt / 2^20 is far below
-// any time scale a scene resolves.
-constexpr int kMaxStepCutbacks = 20;
+// Halvings of a failed step at most (Settings::step_cutbacks): dt / 1024, and at most 2^10 parts
+// of one step when every part fails whole.
+constexpr int kMaxStepCutbacks = 10;
 
 struct Settings {
   Analysis analysis = Analysis::dynamic;

@@ -14,7 +14,8 @@ namespace {
 // trapezoidal residual, in which a force acting over the step enters with weight 2 (as the
 // coupling force does, assembly.cpp): the force on the bodies is lambda / 2.
 constexpr double kNewmarkContactForceFactor = 0.5;
-// Cut-back steps announced on stderr; later ones are only counted (Solver::cut_steps).
+// Failed attempts (of a step or of one of its parts) noted on stderr; later ones are not noted,
+// the steps they cut are still counted (Solver::cut_steps).
 constexpr long kCutbackNotes = 10;
 
 }  // namespace

@@ -50,6 +50,7 @@ class SolidProgram : public fsi::SolidPort {
   StepState m_start;  // the state the current step started from (coupled iterations)
   long m_start_step = -1;  // the step m_start belongs to (-1: none kept)
   long m_newton_total = 0, m_newton_max = 0, m_steps = 0, m_repeats = 0, m_written_step = -1;
+  long m_cut_steps = 0;  // steps taken in parts after a failure (step_cutbacks)
   double m_assembly = 0, m_factor = 0, m_solve = 0;
 };
 

@@ -546,47 +546,6 @@ TEST_CASE("self-contact: two nodes at each other's vertex are one contact",
   CHECK(slot(a).normal[0] == Approx(-1.0));
 }
 
-// Node a at b's vertex while b is on an edge that ends at a, a hair from a (a crease closing):
-// one contact too, b's feature made a's vertex. Farther from a than kSelfJoinNear reaches (5 %:
-// 0.0025 here), b keeps the edge.
-TEST_CASE("self-contact: a node at a vertex that lies on the node's own edge is one contact",
-          "[contact]") {
-  const Mesh mesh = u_mesh();
-  const int a = u_node(mesh, 0.15, 1.0), b = u_node(mesh, 0.35, 1.0);
-  const int c = u_node(mesh, 0.1, 1.0);  // a's neighbour along the left arm's top
-  REQUIRE(a >= 0);
-  REQUIRE(b >= 0);
-  REQUIRE(c >= 0);
-  ContactSet set;
-  setup_self_contact(set, mesh);
-  auto slot = [&](int n) -> const ContactSlot& { return slot_of(set, n); };
-  std::vector<double> x = mesh.x;
-  const std::vector<double> reach = {0.05};
-  // a 0.002 up and left of b (in b's vertex cone: b is a's feature; outside a's vertex zone,
-  // 1e-3), its top edge c-a swung over b: b lies 1.5e-3 from that edge, 1.3e-3 along it from a.
-  x[2 * c] = 0.45, x[2 * c + 1] = 1.02;
-  x[2 * a] = 0.3484, x[2 * a + 1] = 1.0012;
-  set.detect({&x}, reach);
-  CHECK(slot(a).m0 == b);
-  CHECK(slot(a).m1 == -1);
-  CHECK(slot(b).m0 == a);
-  CHECK(slot(b).m1 == -1);
-  const Vec2 n = slot(a).normal;
-  CHECK(std::hypot(n[0], n[1]) == Approx(1.0));
-  CHECK(slot(b).normal[0] == -n[0]);
-  CHECK(slot(b).normal[1] == -n[1]);
-  const double g = (x[2 * a] - x[2 * b]) * n[0] + (x[2 * a + 1] - x[2 * b + 1]) * n[1];
-  CHECK(slot(a).gap == g);
-  CHECK(slot(b).gap == g);
-  CHECK(g > 0);  // both outside: apart
-  // a 0.005 from b: b lies 3.5e-3 along c-a from a, and keeps that edge.
-  x[2 * a] = 0.346, x[2 * a + 1] = 1.003;
-  set.detect({&x}, reach);
-  CHECK(slot(b).m1 >= 0);
-  CHECK((slot(b).m0 == a || slot(b).m1 == a));
-  CHECK(slot(a).m0 == b);
-  CHECK(slot(a).m1 == -1);
-}
 
 // A node behind a feature it did not face at the step's start counts as having gone through it
 // only as deep as it and the feature moved since (twice that): deeper, it is the body's other
