@@ -151,10 +151,6 @@ void validate(const Config& c, double dt) {
     bad(c,
         "fluid.grid.y_band stretches y, which is periodic; the fast Poisson solver transforms "
         "periodic directions, which must be uniform");
-  if (c.x.band_cells > 0 && y_stretched)
-    bad(c,
-        "fluid.grid.x_band with a stretched y (y_band or y_stretch): the fast Poisson solver "
-        "needs one uniform direction to transform");
   if (c.x.sponge_cells > 0 && c.bc[right].type != BcType::outflow &&
       c.bc[right].type != BcType::pressure) {
     bad(c, fmt::format("fluid.sponge needs an outflow or a pressure boundary on the right side, got "
@@ -166,13 +162,12 @@ void validate(const Config& c, double dt) {
                        "solver transforms periodic directions, which must be uniform",
                        c.y.tanh_beta));
   }
-  if (x_sponge && y_stretched) {
-    bad(c,
-        fmt::format("{} with a stretched outlet sponge in x: the fast Poisson solver needs one "
-                    "uniform direction to transform",
-                    c.y.band_cells > 0 ? std::string("fluid.grid.y_band")
-                                       : fmt::format("fluid.grid.y_stretch = {}", c.y.tanh_beta)));
-  }
+  if (x_stretched && y_stretched && c.implicit && !c.factored_helmholtz)
+    bad(c, fmt::format("fluid.helmholtz = \"direct\" needs one uniform direction; {} and a stretched "
+                       "x ({}) stretch both: use helmholtz = \"factored\" (the default)",
+                       c.y.band_cells > 0 ? std::string("fluid.grid.y_band")
+                                          : fmt::format("fluid.grid.y_stretch = {}", c.y.tanh_beta),
+                       x_sponge ? "fluid.sponge" : "fluid.grid.x_band"));
   if (x_sponge && px) bad(c, "fluid.sponge: the sponge stretches x, which is periodic");
   if (!(dt > 0)) bad(c, fmt::format("time.dt must be > 0, got {}", dt));
   const double nu = c.viscosity / c.density;

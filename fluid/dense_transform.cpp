@@ -210,6 +210,10 @@ std::vector<double> DenseTransform::matrix(fftw_r2r_kind kind, int n) {
 }
 
 DenseTransform::DenseTransform(fftw_r2r_kind kind, int n, int lines, int dist, Kernel kernel)
+    : DenseTransform(matrix(kind, n), n, lines, dist, kernel) {}
+
+DenseTransform::DenseTransform(const std::vector<double>& c, int n, int lines, int dist,
+                               Kernel kernel)
     : m_n(n),
       m_lines(lines),
       m_dist(dist),
@@ -217,7 +221,8 @@ DenseTransform::DenseTransform(fftw_r2r_kind kind, int n, int lines, int dist, K
       m_vector_kernel(kernel == Kernel::best && vectorised()) {
   if (n < 2 || lines < 1 || dist < n)
     fsi::fail("fluid::DenseTransform: {} lines of length {}, {} apart", lines, n, dist);
-  const std::vector<double> c = matrix(kind, n);
+  if (c.size() != static_cast<std::size_t>(n) * n)
+    fsi::fail("fluid::DenseTransform: a matrix of {} entries for length {}", c.size(), n);
   const auto at = [&](int k, int j) { return c[static_cast<std::size_t>(k) * n + j]; };
   double cmax = 0;
   for (double v : c) cmax = std::max(cmax, std::abs(v));

@@ -1,4 +1,4 @@
-// A real transform of one of FFTW's r2r kinds done as a matrix product, for the lengths where
+// A real transform of one of FFTW's r2r kinds (or any given matrix) done as a matrix product, for the lengths where
 // FFTW 3.3's planner (FFTW_ESTIMATE) takes its generic O(n^2) scalar code (an odd prime below
 // 173, or such a factor: 101 rows of the vocal folds' channel at h = 0.01, 41 in 82, 123, 164):
 // the same O(n^2) work, half of it saved by the matrix's symmetry and the rest vectorised across
@@ -20,6 +20,9 @@ class DenseTransform {
   // The transform `kind` of length n >= 2 (FFTW's definition, unnormalised) on `lines` lines of
   // n contiguous values each, line l starting at l * dist (dist >= n).
   DenseTransform(fftw_r2r_kind kind, int n, int lines, int dist, Kernel kernel = Kernel::best);
+  // Any n x n matrix c (row-major) as the transform: y = c x on each line.
+  DenseTransform(const std::vector<double>& c, int n, int lines, int dist,
+                 Kernel kernel = Kernel::best);
   // In place on the lines starting at x.
   void apply(double* x);
 

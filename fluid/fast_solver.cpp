@@ -2,6 +2,8 @@
 // Helmholtz problems on the MAC grid.
 #include "fast_solver.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <cmath>
 #include <numbers>
 
@@ -103,11 +105,68 @@ std::vector<double> eigenvalues(int n, double h, Closure lo, Closure hi) {
   return lam;
 }
 
+// A stretched direction's L (rows a, b, c) is similar to the symmetric tridiagonal
+//   S = D L D^-1,  D = diag(d),  d[k+1] / d[k] = sqrt(c[k] / a[k+1]),
+// whose diagonal is b and whose off-diagonals are sqrt(a[k+1] c[k]). With S = Q diag(lambda) Q^T
+// (Q orthogonal): L = (D^-1 Q) diag(lambda) (Q^T D), so F = Q^T D and B = D^-1 Q. For the
+// pressure operator d^2 is proportional to the cell widths w: F's row of the zero eigenvalue is
+// then proportional to w (the constant mode's coefficient is the w-weighted mean) and every other
+// mode's backward image has zero w-weighted mean.
+EigenTransform eigen_transform(const Operator1D& t) {
+  const int n = t.n;
+  if (n < 2 || int(t.a.size()) != n || int(t.b.size()) != n || int(t.c.size()) != n)
+    fsi::fail("fluid::eigen_transform: {} unknowns with {} rows", n, t.b.size());
+  std::vector<double> d(n, 1.0);
+  Eigen::VectorXd diag(n), off(n - 1);
+  for (int k = 0; k < n; ++k) diag[k] = t.b[k];
+  for (int k = 0; k + 1 < n; ++k) {
+    const double ac = t.a[k + 1] * t.c[k];
+    if (!(ac > 0))
+      fsi::fail("fluid::eigen_transform: rows {} and {} couple with signs that no diagonal scaling "
+                "makes symmetric (a c = {})",
+                k, k + 1, ac);
+    off[k] = std::sqrt(ac);
+    d[k + 1] = d[k] * std::sqrt(t.c[k] / t.a[k + 1]);
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es;
+  es.computeFromTridiagonal(diag, off, Eigen::ComputeEigenvectors);
+  if (es.info() != Eigen::Success) fsi::fail("fluid::eigen_transform: no eigen-decomposition");
+  const Eigen::MatrixXd& q = es.eigenvectors();
+  EigenTransform e;
+  e.lambda.assign(es.eigenvalues().data(), es.eigenvalues().data() + n);
+  if (t.singular) {
+    // The constant's eigenvalue, zero to round-off: exactly zero, for the Thomas sweep's choice.
+    int z = 0;
+    for (int m = 1; m < n; ++m)
+      if (std::abs(e.lambda[m]) < std::abs(e.lambda[z])) z = m;
+    e.lambda[z] = 0.0;
+  }
+  e.fwd.resize(std::size_t(n) * n);
+  e.bwd.resize(std::size_t(n) * n);
+  for (int m = 0; m < n; ++m)
+    for (int k = 0; k < n; ++k) {
+      e.fwd[std::size_t(m) * n + k] = q(k, m) * d[k];
+      e.bwd[std::size_t(k) * n + m] = q(k, m) / d[k];
+    }
+  return e;
+}
+
 FastSolver::FastSolver(const Operator1D& t, const Operator1D& s, double sigma)
     : m_nt(t.n), m_ns(s.n), m_transform_s(s.lo == Closure::periodic) {
   const std::size_t size = std::size_t(m_nt) * m_ns;
   m_buf = fftw_alloc_real(size);
   for (std::size_t q = 0; q < size; ++q) m_buf[q] = 0;
+  if (!t.a.empty()) {
+    // A stretched t: its eigenvectors as dense products (norm 1), Thomas along s.
+    if (m_transform_s)
+      fsi::fail("fluid::FastSolver: a stretched transform direction beside a periodic one");
+    const EigenTransform et = eigen_transform(t);
+    m_dense_fwd = std::make_unique<DenseTransform>(et.fwd, m_nt, m_ns, m_nt);
+    m_dense_bwd = std::make_unique<DenseTransform>(et.bwd, m_nt, m_ns, m_nt);
+    m_a = s.a;
+    m_zero_mode = thomas_factors(s, et.lambda, sigma, 0, m_nt, m_inv_piv, m_gamma);
+    return;
+  }
   const TransformPair kt = transform_pair(m_nt, t.lo, t.hi);
   const std::vector<double> lt = eigenvalues(m_nt, t.h, t.lo, t.hi);
   // FFTW_ESTIMATE: the plan does not depend on timings, so two runs are bit-identical.

@@ -1,9 +1,10 @@
 // Direct fast solver for (L_t + L_s - sigma) x = r on a 2D array of unknowns, where L_t and L_s
-// are the 1D second-difference operators along the two grid directions. The transform
-// direction t must be uniform: FFTW's real transforms (DFT for periodic, DCT/DST for the other
-// closures) diagonalise L_t exactly, so the solve is exact to round-off. The other direction s
-// may be stretched: it is solved by a tridiagonal (Thomas) sweep per wavenumber, or transformed
-// too when it is periodic. Used for the pressure Poisson equation (sigma = 0) and for the
+// are the 1D second-difference operators along the two grid directions. Along a uniform transform
+// direction t FFTW's real transforms (DFT for periodic, DCT/DST for the other closures)
+// diagonalise L_t exactly; along a stretched one (not periodic) its own eigenvectors do, as
+// dense products (eigen_transform). Either way the solve is exact to round-off. The other
+// direction s may be stretched: it is solved by a tridiagonal (Thomas) sweep per wavenumber, or
+// transformed too when it is periodic. Used for the pressure Poisson equation (sigma = 0) and for the
 // Crank-Nicolson Helmholtz equations of the velocity components (sigma = 2 / (nu dt)).
 #pragma once
 
@@ -21,8 +22,8 @@ namespace fluid {
 //   dirichlet_half / neumann_half: zero value / zero gradient half a spacing beyond it
 enum class Closure { periodic, dirichlet_node, dirichlet_half, neumann_half };
 
-// A 1D operator along one direction: n unknowns. In a transform direction only n, h and the
-// closures matter. In a tridiagonal direction row k reads a[k] x[k-1] + b[k] x[k] + c[k] x[k+1]
+// A 1D operator along one direction: n unknowns. In a uniform transform direction only n, h and
+// the closures matter (a, b, c empty); a stretched transform direction gives its rows. In a tridiagonal direction row k reads a[k] x[k-1] + b[k] x[k] + c[k] x[k+1]
 // (a[0] = c[n-1] = 0), whatever the grid and the boundary rows; `singular` says the operator
 // annihilates constants (pure Neumann), so that the sigma = 0 problem is solved up to a constant.
 struct Operator1D {
@@ -44,6 +45,15 @@ struct TransformPair {
 };
 TransformPair transform_pair(int n, Closure lo, Closure hi);
 
+// The eigen-decomposition of a transform direction given by its rows (a stretched direction):
+// L = B diag(lambda) F with F B = I, F and B n x n row-major (the forward and the backward
+// transform). L must be similar to a symmetric matrix through a diagonal one (a[k+1] c[k] > 0);
+// a singular L gets its zero eigenvalue exactly.
+struct EigenTransform {
+  std::vector<double> lambda, fwd, bwd;
+};
+EigenTransform eigen_transform(const Operator1D& t);
+
 // The Thomas factors of (a, b + lambda_k - sigma, c) along s for the wavenumbers k = k0 + col,
 // col in [0, cols), stored per (j, col) with col fastest: inverse pivots and gammas (resized).
 // Columns with k < 0 (padded rows of a slab) stay zero. A singular problem's zero mode
@@ -61,8 +71,8 @@ void remove_weighted_mean(double* x, int cols, int col, int ns, const std::vecto
 
 class FastSolver {
  public:
-  // t: the transform direction's operator (uniform); s: the other one. When s.lo is periodic,
-  // s is transformed too. The unknowns are stored t-fastest: x[k + nt * j].
+  // t: the transform direction's operator (uniform, or stretched with its rows); s: the other
+  // one. When s.lo is periodic (t then uniform), s is transformed too. The unknowns are stored t-fastest: x[k + nt * j].
   FastSolver(const Operator1D& t, const Operator1D& s, double sigma);
   ~FastSolver();
   FastSolver(const FastSolver&) = delete;
@@ -72,7 +82,7 @@ class FastSolver {
   int ns() const { return m_ns; }
   double* data() { return m_buf; }  // right-hand side in, solution out
   // Solve in place on data(). For sigma = 0 with a singular operator, the solution has zero
-  // mean weighted by `weights` (per s-row; the t-direction is uniform) when given.
+  // mean weighted by `weights` (per s-row) and by the t-direction's cell widths when given.
   void solve();
   // The three phases, for the benchmark of a bare solve.
   void forward();
@@ -88,7 +98,8 @@ class FastSolver {
   double* m_buf = nullptr;
   fftw_plan m_fwd = nullptr, m_bwd = nullptr;
   // The t-transforms as matrix products where FFTW has only its generic O(n^2) code for the
-  // length (DenseTransform::preferred; not with s periodic, the 2D plan); null: FFTW's plans.
+  // length (DenseTransform::preferred; not with s periodic, the 2D plan) or where t is stretched
+  // (eigen_transform); null: FFTW's plans.
   std::unique_ptr<DenseTransform> m_dense_fwd, m_dense_bwd;
   double m_norm = 1;
   std::vector<double> m_a;                // sub-diagonal per s-row

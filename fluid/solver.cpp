@@ -16,7 +16,8 @@ namespace {
 
 enum class Loc { pressure, normal, tangential };
 
-// The 1D operator along axis `ax` for a quantity at location `loc`, bounded by sides lo/hi.
+// The 1D operator along axis `ax` for a quantity at location `loc`, bounded by sides lo/hi; as a
+// uniform transform direction without its rows.
 //   pressure (cell centres, finite volume, zero normal gradient at walls):
 //     row k: [(x_{k+1}-x_k)/d_{k+1} - (x_k-x_{k-1})/d_k] / w_k
 //   normal velocity (faces 1..n-1, boundary faces given):
@@ -37,7 +38,7 @@ Operator1D make_operator(const Axis& ax, Loc loc, bool transform, const Boundari
   if (loc == Loc::normal) {
     op.n = n - 1;
     op.lo = op.hi = Closure::dirichlet_node;
-    if (transform) return op;
+    if (transform && ax.uniform()) return op;
     op.a.resize(n - 1);
     op.b.resize(n - 1);
     op.c.resize(n - 1);
@@ -83,7 +84,7 @@ Operator1D make_operator(const Axis& ax, Loc loc, bool transform, const Boundari
       gcoef = 0;
     }
   }
-  if (transform) {
+  if (transform && ax.uniform()) {  // a stretched transform direction keeps its rows
     op.a.clear();
     op.b.clear();
     op.c.clear();
@@ -126,7 +127,14 @@ Solver::Solver(const Config& c, double dt, MPI_Comm comm)
   validate(c, dt);
   m_nu = c.viscosity / c.density;
   const int nx = m_grid.nx(), ny = m_grid.ny();
+  // The transform axis: x where it is uniform, else y (stretched too: its eigenvectors, one rank).
   m_t_axis = m_grid.x().uniform() ? 0 : 1;
+  if (!m_grid.x().uniform() && !m_grid.y().uniform() && !m_dec.serial())
+    throw fsi::InputError(fmt::format(
+        "fluid.grid: x and y both stretched need the fluid on one rank (the pressure solve's "
+        "stretched transform runs on one rank); set fluid.ranks = 1, or keep one direction "
+        "uniform (in {})",
+        c.source));
   m_i0 = m_grid.x().periodic() ? 0 : 1;
   m_j0 = m_grid.y().periodic() ? 0 : 1;
   m_iu0 = m_bnd.is_pressure(left) ? 0 : m_i0;

@@ -6,6 +6,8 @@ its observed order, wall times, plots. `--short`: CFD1 on the two coarser grids 
 `--dt-study`: CFD1 and CFD2 on the coarsest grid at several time steps (dt_study.md/.json).
 `--bands`: CFD1 and CFD2 on 750 columns and 123 rows, 72 of them in a y band over the cylinder
 and the bar (fluid.grid.y_band), against the uniform grids (bands.json; about 12 min).
+`--bands-xy`: CFD1 and CFD2 with bands in both x and y around the body at three spacings
+(XY_LEVELS; bands_xy.json).
 `--reuse`: keep a run whose folder in FSI_OUT has a summary.json from the identical scene text.
 `--helmholtz direct|factored`: fluid.helmholtz in the scenes (factored by default: the key is
 always written, so that --reuse never takes a run of the direct solve for one of the factored);
@@ -32,6 +34,8 @@ _p.add_argument("--dt-study", action="store_true", help="the forces against the 
 _p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
 _p.add_argument("--bands", action="store_true",
                 help="CFD1 and CFD2 on 750 x 123 with 72 rows in a y band around the body")
+_p.add_argument("--bands-xy", action="store_true",
+                help="CFD1 and CFD2 with bands in x and y around the body, three spacings")
 _p.add_argument("--helmholtz", choices=["direct", "factored"], default="factored",
                 help="fluid.helmholtz of the scenes (Crank-Nicolson's Helmholtz solves)")
 ARGS = _p.parse_args()
@@ -79,21 +83,24 @@ def time_step(case, h):
     return 0.25 * h / (CASES[case]["U"] if SHORT else 1.0)
 
 
-def scene_text(case, n, dt=None, band=None, name=None):
+def scene_text(case, n, dt=None, band=None, name=None, x_band=None, columns=None, lc=None):
     """The committed scene with the grid, time step, run time and mesh size of level n; `band`
-    (from, to, rows): a y band in the grid, the columns staying those of level n."""
+    (from, to, rows): a y band in the grid, the columns staying those of level n unless
+    `columns` (with `x_band` (from, to, columns) in them) says otherwise; `lc` the body's mesh
+    size (default h)."""
     h = H / n
-    nx = int(round(L / h))
+    nx = int(round(L / h)) if columns is None else columns
     dt = time_step(case, h) if dt is None else dt
     t_end = T_END[case]
     replace = {
         "name": f'name = "{name or f"{case}-n{n}"}"',
         "cells": f"cells = [{nx}, {n}]" + (
-            "\ny_band = {{ from = {:g}, to = {:g}, cells = {} }}".format(*band) if band else ""),
+            "\ny_band = {{ from = {:g}, to = {:g}, cells = {} }}".format(*band) if band else "") + (
+            "\nx_band = {{ from = {:g}, to = {:g}, cells = {} }}".format(*x_band) if x_band else ""),
         "dt": f"dt = {dt:.10g}",
         "t_end": f"t_end = {t_end:g}",
         "interval": f"interval = {t_end:g}",
-        "mesh_parameters": f'mesh_parameters = "lc = {h:.10g}"',
+        "mesh_parameters": f'mesh_parameters = "lc = {(h if lc is None else lc):.10g}"',
     }
     lines = []
     for line in open(os.path.join(HERE, f"{case}.toml")).read().splitlines():
@@ -330,10 +337,49 @@ def bands():
         json.dump(rows, f, indent=2)
 
 
+# Bands in x and y at once (the pressure solve then transforms y by its eigenvectors): the
+# cylinder (x 0.15-0.25, y 0.15-0.25) and the bar (to x = 0.6, y 0.19-0.21) inside cells of side
+# hb over x in [0.1, 0.7], y in [0.14, 0.26]; the rest growing to the walls, the inlet and the
+# outlet (ratio <= 1.2). Per level: hb, columns, rows; dt = 0.3 hb s/m (as the y band's 5e-4 at
+# 1.67 mm), the body's mesh size hb.
+XY_LEVELS = [(0.41 / 246, 600, 123), (0.41 / 328, 760, 152), (0.41 / 410, 920, 184)]
+
+
+def bands_xy():
+    """CFD1 and CFD2 with bands in x and y (XY_LEVELS), against the benchmark: error against the
+    band's spacing and against wall time (bands_xy.json)."""
+    rows = []
+    for hb, nx, ny in XY_LEVELS:
+        xb = (0.1, 0.7, int(round(0.6 / hb)))
+        yb = (0.14, 0.26, int(round(0.12 / hb)))
+        tag = f"xy-{nx}x{ny}"
+        for case in ["cfd1", "cfd2"]:
+            ref = CASES[case]
+            text, dt = scene_text(case, ny, dt=round(0.3 * hb, 7), band=yb, name=f"{case}-{tag}",
+                                  x_band=xb, columns=nx, lc=hb)
+            job_run = job.run(f"{case}-{tag}", text, reuse=REUSE)
+            folder, wall = job_run.folder, job_run.wall
+            t, fx, fy = forces(folder)
+            d, l = analyse(t, fx, 2.0), analyse(t, fy, 2.0)
+            r = {"case": case, "cells": [nx, ny], "x_band": xb, "y_band": yb, "band_h": hb,
+                 "dt": dt, "wall_s": wall, "cpu_s": job_run.cpu,
+                 "steps": outputs.summary(folder)["steps"],
+                 "drag": d, "lift": l, "drag_error": d["value"] / ref["drag"] - 1.0,
+                 "lift_error": l["value"] / ref["lift"] - 1.0}
+            rows.append(r)
+            print(f"{case} {nx} x {ny}, bands of {1e3 * hb:.3f} mm ({r['steps']} steps, {wall:.0f} s): "
+                  f"drag {d['value']:.4f} ({100 * r['drag_error']:+.2f} %), lift {l['value']:.4f} "
+                  f"({100 * r['lift_error']:+.2f} %)", flush=True)
+            with open(os.path.join(OUT, "bands_xy.json"), "w") as f:
+                json.dump(rows, f, indent=2)
+
+
 if __name__ == "__main__":
     if ARGS.dt_study:
         dt_study()
     elif ARGS.bands:
         bands()
+    elif ARGS.bands_xy:
+        bands_xy()
     else:
         main()
