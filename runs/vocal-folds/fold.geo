@@ -14,6 +14,7 @@ DefineConstant[
   h = {0, Name "clearance h/D"},
   cover = {0.025, Name "cover thickness"},
   lc = {0.024, Name "element size"},
+  lc_cover = {0, Name "element size at the wetted surface (0: lc)"},
   side = {1, Name "1: bottom fold, -1: top fold"},
   x0 = {2.0, Name "x of the superior (downstream) face"},
   T = {0.15, Name "M5 axial glottal length T"},
@@ -90,6 +91,21 @@ Curve Loop(1) = {1, 2, 3, 4, 5, 21, -15, -14, -13, -12, -11, 23};
 Plane Surface(1) = {1};
 Curve Loop(2) = {11, 12, 13, 14, 15, 22};
 Plane Surface(2) = {2};
+
+// A finer mesh at the surface the flow wets (lc_cover < lc): lc_cover within the cover's
+// thickness of it, growing linearly to lc at three times that.
+If (lc_cover > 0 && lc_cover < lc)
+  Field[1] = Distance;
+  Field[1].CurvesList = {1, 2, 3, 4, 5};
+  Field[1].NumPointsPerCurve = 200;
+  Field[2] = Threshold;
+  Field[2].InField = 1;
+  Field[2].SizeMin = lc_cover;
+  Field[2].SizeMax = lc;
+  Field[2].DistMin = cover;
+  Field[2].DistMax = 3 * cover;
+  Background Field = 2;
+EndIf
 
 Physical Surface("cover") = {1};
 Physical Surface("body") = {2};

@@ -75,6 +75,9 @@ P.add_argument("--dt", type=cli.positive, default=None,
                help="the coupled runs' time step (default: the scene's, the paper's 5e-5)")
 P.add_argument("--substeps", type=int, metavar="M", default=None,
                help="the fluid up to M substeps per step, each at a CFL number of at most 0.8")
+P.add_argument("--cover-size", type=cli.positive, metavar="LC", default=None,
+               help="the folds' element size within the cover's thickness of the wetted surface "
+                    "(fold.geo's lc_cover; default: the element size lc = 0.024 throughout)")
 P.add_argument("--checkpoint-interval", type=cli.positive, metavar="T", default=None,
                help="the coupled runs write a checkpoint every T")
 ARGS = P.parse_args()
@@ -95,6 +98,9 @@ if ARGS.wall_planes:
 if ARGS.substeps is not None:
     OUT = job.OUT = os.path.join(OUT, f"substeps-{ARGS.substeps}")
     os.makedirs(OUT, exist_ok=True)
+if ARGS.cover_size is not None:
+    OUT = job.OUT = os.path.join(OUT, f"cover-{ARGS.cover_size:g}")
+    os.makedirs(OUT, exist_ok=True)
 HERE = os.path.dirname(os.path.abspath(__file__))
 GEO = os.path.join(HERE, "fold.geo")
 PAPER_MODES = (1.85, 4.12, 5.45)
@@ -107,6 +113,8 @@ def scene(h, grid="paper", t_end=10.0, interval=0.05, ramp=None, fluid=True, mod
     text = open(os.path.join(HERE, "scene.toml")).read()
     text = text.replace('mesh = "fold.geo"', f'mesh = "{GEO}"')
     text = text.replace('model = "saint-venant-kirchhoff"', f'model = "{ARGS.material}"')
+    if ARGS.cover_size is not None:
+        text = text.replace(", side = ", f", lc_cover = {ARGS.cover_size!r}, side = ")
     text = text.replace("h = 0.02", f"h = {h!r}").replace("0.52]", f"{0.5 + h!r}]")
     nx, ny, sponge, ratio = (560, round(100 * (1 + h)), 40, 1.05) if grid == "paper" else \
         (140, round(25 * (1 + h)), 10, 1.2)
