@@ -210,10 +210,10 @@ std::vector<double> DenseTransform::matrix(fftw_r2r_kind kind, int n) {
 }
 
 DenseTransform::DenseTransform(fftw_r2r_kind kind, int n, int lines, int dist, Kernel kernel)
-    : DenseTransform(matrix(kind, n), n, lines, dist, kernel) {}
+    : DenseTransform(matrix(kind, n), n, lines, dist, true, kernel) {}
 
 DenseTransform::DenseTransform(const std::vector<double>& c, int n, int lines, int dist,
-                               Kernel kernel)
+                               bool symmetric, Kernel kernel)
     : m_n(n),
       m_lines(lines),
       m_dist(dist),
@@ -238,7 +238,7 @@ DenseTransform::DenseTransform(const std::vector<double>& c, int n, int lines, i
     return plus ? 1 : minus ? -1 : 0;
   };
   std::vector<int> row_sign(n), col_sign(n);
-  bool rows_ok = true, cols_ok = true;
+  bool rows_ok = symmetric, cols_ok = symmetric;
   for (int i = 0; i < n; ++i) {
     row_sign[i] = sign_of([&](int j) { return at(i, rev(j)); }, [&](int j) { return at(i, j); });
     col_sign[i] = sign_of([&](int k) { return at(rev(k), i); }, [&](int k) { return at(k, i); });

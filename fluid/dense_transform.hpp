@@ -20,8 +20,10 @@ class DenseTransform {
   // The transform `kind` of length n >= 2 (FFTW's definition, unnormalised) on `lines` lines of
   // n contiguous values each, line l starting at l * dist (dist >= n).
   DenseTransform(fftw_r2r_kind kind, int n, int lines, int dist, Kernel kernel = Kernel::best);
-  // Any n x n matrix c (row-major) as the transform: y = c x on each line.
-  DenseTransform(const std::vector<double>& c, int n, int lines, int dist,
+  // Any n x n matrix c (row-major) as the transform: y = c x on each line. With `symmetric`
+  // false the product is never halved: a matrix whose rows or columns are even or odd only to
+  // round-off (computed eigenvectors) is used whole, so the result stays exact to round-off.
+  DenseTransform(const std::vector<double>& c, int n, int lines, int dist, bool symmetric,
                  Kernel kernel = Kernel::best);
   // In place on the lines starting at x.
   void apply(double* x);

@@ -161,8 +161,8 @@ FastSolver::FastSolver(const Operator1D& t, const Operator1D& s, double sigma)
     if (m_transform_s)
       fsi::fail("fluid::FastSolver: a stretched transform direction beside a periodic one");
     const EigenTransform et = eigen_transform(t);
-    m_dense_fwd = std::make_unique<DenseTransform>(et.fwd, m_nt, m_ns, m_nt);
-    m_dense_bwd = std::make_unique<DenseTransform>(et.bwd, m_nt, m_ns, m_nt);
+    m_dense_fwd = std::make_unique<DenseTransform>(et.fwd, m_nt, m_ns, m_nt, false);
+    m_dense_bwd = std::make_unique<DenseTransform>(et.bwd, m_nt, m_ns, m_nt, false);
     m_a = s.a;
     m_zero_mode = thomas_factors(s, et.lambda, sigma, 0, m_nt, m_inv_piv, m_gamma);
     return;

@@ -112,6 +112,9 @@ SlabSolver::SlabSolver(const Operator1D& t, const Operator1D& s, double sigma, i
   // A transpose sends this rank's values but its own block: about (P - 1) / P of its share.
   m_bytes_per_transpose = 8.0 * double(rows) * ncol / ranks * (ranks - 1) / ranks;
 
+  if (!t.a.empty())
+    fsi::fail("fluid::SlabSolver: a stretched transform direction (both directions stretched) "
+              "is solved on one rank only");
   const TransformPair kt = transform_pair(m_nt, t.lo, t.hi);
   m_lt = eigenvalues(m_nt, t.h, t.lo, t.hi);
   m_norm = kt.norm;

@@ -7,7 +7,9 @@ its observed order, wall times, plots. `--short`: CFD1 on the two coarser grids 
 `--bands`: CFD1 and CFD2 on 750 columns and 123 rows, 72 of them in a y band over the cylinder
 and the bar (fluid.grid.y_band), against the uniform grids (bands.json; about 12 min).
 `--bands-xy`: CFD1 and CFD2 with bands in both x and y around the body at three spacings
-(XY_LEVELS; bands_xy.json).
+(XY_LEVELS; bands_xy.json). `--bands-xy-dt`: CFD1 on the first of them at two smaller time steps
+(bands_xy_dt.json).
+`--cost`: error against CPU time of what those wrote (cost.md, cost.png; runs nothing).
 `--reuse`: keep a run whose folder in FSI_OUT has a summary.json from the identical scene text.
 `--helmholtz direct|factored`: fluid.helmholtz in the scenes (factored by default: the key is
 always written, so that --reuse never takes a run of the direct solve for one of the factored);
@@ -36,6 +38,10 @@ _p.add_argument("--bands", action="store_true",
                 help="CFD1 and CFD2 on 750 x 123 with 72 rows in a y band around the body")
 _p.add_argument("--bands-xy", action="store_true",
                 help="CFD1 and CFD2 with bands in x and y around the body, three spacings")
+_p.add_argument("--bands-xy-dt", action="store_true",
+                help="CFD1 on the first --bands-xy level at dt 2.5e-4 and 1.25e-4 (--bands-xy: 5e-4)")
+_p.add_argument("--cost", action="store_true",
+                help="error against CPU time of the runs the other modes wrote (cost.md, cost.png)")
 _p.add_argument("--helmholtz", choices=["direct", "factored"], default="factored",
                 help="fluid.helmholtz of the scenes (Crank-Nicolson's Helmholtz solves)")
 ARGS = _p.parse_args()
@@ -118,9 +124,9 @@ def scene_text(case, n, dt=None, band=None, name=None, x_band=None, columns=None
 
 def run(name, text):
     """Run fluid + solid + coupler on the scene into OUT/name (OUT/name-direct with the direct
-    Helmholtz solves); (folder, wall s)."""
+    Helmholtz solves); (folder, wall s, CPU s of the job; None for a reused run)."""
     r = job.run(name + ("-direct" if ARGS.helmholtz == "direct" else ""), text, reuse=REUSE)
-    return r.folder, r.wall
+    return r.folder, r.wall, r.cpu
 
 
 def forces(folder):
@@ -192,13 +198,13 @@ def main():
         results = []
         for n in LEVELS:
             text, dt = scene_text(case, n)
-            folder, wall = run(f"{case}-n{n}", text)
+            folder, wall, cpu = run(f"{case}-n{n}", text)
             t, fx, fy = forces(folder)
             window = 2.0
             d, l = analyse(t, fx, window), analyse(t, fy, window)
             steps = outputs.summary(folder)["steps"]
             row = {"case": case, "cells_across": n, "h": H / n, "cells": [int(round(L * n / H)), n],
-                   "dt": dt, "steps": steps, "wall_s": wall,
+                   "dt": dt, "steps": steps, "wall_s": wall, "cpu_s": cpu,
                    "drag": d, "lift": l,
                    "drag_error": abs(d["value"] - ref["drag"]) / ref["drag"],
                    "lift_error": abs(l["value"] - ref["lift"]) / ref["lift"]}
@@ -294,7 +300,7 @@ def dt_study():
         ref = CASES[case]
         for k in factors:
             text, dt = scene_text(case, n, 0.25 * k * H / n / CASES[case]["U"])
-            folder, wall = run(f"dt-{case}-n{n}-{k:g}", text)
+            folder, wall, _ = run(f"dt-{case}-n{n}-{k:g}", text)
             t, fx, fy = forces(folder)
             r = {"case": case, "cells_across": n, "dt": dt, "cfl": CASES[case]["U"] * dt * n / H,
                  "drag": float(fx[-1]), "lift": float(fy[-1]),
@@ -322,10 +328,10 @@ def bands():
     for case in ["cfd1", "cfd2"]:
         ref = CASES[case]
         text, dt = scene_text(case, 123, dt=5e-4, band=band, name=f"{case}-band-123")
-        folder, wall = run(f"{case}-band-123", text)
+        folder, wall, cpu = run(f"{case}-band-123", text)
         t, fx, fy = forces(folder)
         d, l = analyse(t, fx, 2.0), analyse(t, fy, 2.0)
-        r = {"case": case, "cells": [750, 123], "band": band, "dt": dt, "wall_s": wall,
+        r = {"case": case, "cells": [750, 123], "band": band, "dt": dt, "wall_s": wall, "cpu_s": cpu,
              "steps": outputs.summary(folder)["steps"], "drag": d, "lift": l,
              "drag_error": d["value"] / ref["drag"] - 1.0,
              "lift_error": l["value"] / ref["lift"] - 1.0}
@@ -345,33 +351,81 @@ def bands():
 XY_LEVELS = [(0.41 / 246, 600, 123), (0.41 / 328, 760, 152), (0.41 / 410, 920, 184)]
 
 
-def bands_xy():
+def bands_xy(levels=None, dts=None, cases=("cfd1", "cfd2"), out="bands_xy.json"):
     """CFD1 and CFD2 with bands in x and y (XY_LEVELS), against the benchmark: error against the
-    band's spacing and against wall time (bands_xy.json)."""
+    band's spacing and against wall time (bands_xy.json). `dts`: on each level these time steps
+    instead of 0.3 hb s/m (the forcing's slip in partly covered cells grows with dt: README).
+    A run kept by --reuse has no CPU time (None): rerun it for the cost plot."""
     rows = []
-    for hb, nx, ny in XY_LEVELS:
+    for hb, nx, ny in (levels or XY_LEVELS):
         xb = (0.1, 0.7, int(round(0.6 / hb)))
         yb = (0.14, 0.26, int(round(0.12 / hb)))
-        tag = f"xy-{nx}x{ny}"
-        for case in ["cfd1", "cfd2"]:
-            ref = CASES[case]
-            text, dt = scene_text(case, ny, dt=round(0.3 * hb, 7), band=yb, name=f"{case}-{tag}",
-                                  x_band=xb, columns=nx, lc=hb)
-            job_run = job.run(f"{case}-{tag}", text, reuse=REUSE)
-            folder, wall = job_run.folder, job_run.wall
-            t, fx, fy = forces(folder)
-            d, l = analyse(t, fx, 2.0), analyse(t, fy, 2.0)
-            r = {"case": case, "cells": [nx, ny], "x_band": xb, "y_band": yb, "band_h": hb,
-                 "dt": dt, "wall_s": wall, "cpu_s": job_run.cpu,
-                 "steps": outputs.summary(folder)["steps"],
-                 "drag": d, "lift": l, "drag_error": d["value"] / ref["drag"] - 1.0,
-                 "lift_error": l["value"] / ref["lift"] - 1.0}
-            rows.append(r)
-            print(f"{case} {nx} x {ny}, bands of {1e3 * hb:.3f} mm ({r['steps']} steps, {wall:.0f} s): "
-                  f"drag {d['value']:.4f} ({100 * r['drag_error']:+.2f} %), lift {l['value']:.4f} "
-                  f"({100 * r['lift_error']:+.2f} %)", flush=True)
-            with open(os.path.join(OUT, "bands_xy.json"), "w") as f:
-                json.dump(rows, f, indent=2)
+        for step in (dts or [round(0.3 * hb, 7)]):
+            tag = f"xy-{nx}x{ny}" + (f"-dt{step:g}" if dts else "")
+            for case in cases:
+                ref = CASES[case]
+                text, dt = scene_text(case, ny, dt=step, band=yb, name=f"{case}-{tag}",
+                                      x_band=xb, columns=nx, lc=hb)
+                folder, wall, cpu = run(f"{case}-{tag}", text)
+                t, fx, fy = forces(folder)
+                d, l = analyse(t, fx, 2.0), analyse(t, fy, 2.0)
+                r = {"case": case, "cells": [nx, ny], "x_band": xb, "y_band": yb, "band_h": hb,
+                     "dt": dt, "wall_s": wall, "cpu_s": cpu,
+                     "steps": outputs.summary(folder)["steps"],
+                     "drag": d, "lift": l, "drag_error": d["value"] / ref["drag"] - 1.0,
+                     "lift_error": l["value"] / ref["lift"] - 1.0}
+                rows.append(r)
+                print(f"{case} {nx} x {ny}, bands of {1e3 * hb:.3f} mm, dt {dt:g} ({r['steps']} steps, "
+                      f"{wall:.0f} s): drag {d['value']:.4f} ({100 * r['drag_error']:+.2f} %), lift "
+                      f"{l['value']:.4f} ({100 * r['lift_error']:+.2f} %)", flush=True)
+                with open(os.path.join(OUT, out), "w") as f:
+                    json.dump(rows, f, indent=2)
+
+
+def cost():
+    """Error against CPU time (and cells) of what the other modes wrote: the uniform grids
+    (summary.json's levels), the y band (bands.json), the x and y bands (bands_xy.json,
+    bands_xy_dt.json): cost.md and cost.png. Runs nothing."""
+    groups = []
+    summary = os.path.join(OUT, "summary.json")
+    if os.path.exists(summary):
+        with open(summary) as f:
+            levels = json.load(f).get("levels", [])
+        groups.append(("uniform", "o-", levels))
+    for name, label, style in [("bands.json", "y band", "s"), ("bands_xy.json", "x and y bands", "^-"),
+                               ("bands_xy_dt.json", "x and y bands, smaller dt", "v")]:
+        path = os.path.join(OUT, name)
+        if os.path.exists(path):
+            with open(path) as f:
+                groups.append((label, style, json.load(f)))
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    with open(os.path.join(OUT, "cost.md"), "w") as md:
+        md.write("| grid | case | cells | dt | steps | drag error | lift error | wall s | CPU s |\n"
+                 "|---|---|---|---|---|---|---|---|---|\n")
+        for label, style, rows in groups:
+            for case, ax in zip(["cfd1", "cfd2"], axes):
+                r = [x for x in rows if x["case"] == case and x.get("cpu_s")]
+                if not r:
+                    continue
+                for q, fill in [("drag", None), ("lift", "none")]:
+                    ax.loglog([x["cpu_s"] for x in r], [max(abs(x[f"{q}_error"]), 1e-5) for x in r],
+                              style, mfc=fill, label=f"{label}: {q}")
+            for x in rows:
+                cells = x["cells"][0] * x["cells"][1]
+                cpu = "-" if not x.get("cpu_s") else f"{x['cpu_s']:.0f}"
+                md.write(f"| {label} | {x['case']} | {x['cells'][0]} x {x['cells'][1]} ({cells}) | "
+                         f"{x['dt']:g} | {x['steps']} | {100 * abs(x['drag_error']):.2f} % | "
+                         f"{100 * abs(x['lift_error']):.2f} % | {x['wall_s']:.0f} | {cpu} |\n")
+    for case, ax in zip(["cfd1", "cfd2"], axes):
+        ax.axhline(0.01, color="k", ls=":", lw=0.8)
+        ax.set_xlabel("CPU time of the job [s]")
+        ax.set_ylabel("|error| against Turek & Hron")
+        ax.set_title(case.upper(), fontsize=9)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(OUT, "cost.png"), dpi=120)
+    plt.close(fig)
+    print(open(os.path.join(OUT, "cost.md")).read())
 
 
 if __name__ == "__main__":
@@ -379,7 +433,12 @@ if __name__ == "__main__":
         dt_study()
     elif ARGS.bands:
         bands()
+    elif ARGS.cost:
+        cost()
     elif ARGS.bands_xy:
         bands_xy()
+    elif ARGS.bands_xy_dt:
+        bands_xy(levels=XY_LEVELS[:1], dts=[2.5e-4, 1.25e-4], cases=("cfd1",),
+                 out="bands_xy_dt.json")
     else:
         main()

@@ -248,6 +248,10 @@ TEST_CASE("bands that cannot be laid out are refused with the key", "[fluid][con
   CHECK(with(both).x.band_cells == 8);
   CHECK_THROWS_WITH(
       read(replace(replace(walls, "size = [2.0, 1.0]", "size = [2.0, 1.0]\n" + both),
+                   "viscosity = 0.01", "viscosity = 0.01\nranks = 2")),
+      Contains("fluid.ranks = 2") && Contains("one rank") && Contains("fluid_config_test.toml"));
+  CHECK_THROWS_WITH(
+      read(replace(replace(walls, "size = [2.0, 1.0]", "size = [2.0, 1.0]\n" + both),
                    "viscosity = 0.01", "viscosity = 0.01\ndiffusion = \"implicit\"\nhelmholtz = \"direct\"")),
       Contains("fluid.helmholtz = \"direct\" needs one uniform direction") &&
           Contains("fluid.grid.y_band") && Contains("fluid.grid.x_band"));
