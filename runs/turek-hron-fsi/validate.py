@@ -24,6 +24,8 @@ rho_s = 10 rho_f (only the transient differs).
   validate --fsi1-grids FSI1 on four fluid grids with one bar mesh, to t = 8 (about 15 min)
   validate --fsi1-bands FSI1 on 500 columns with the rows in a y band around the body (82, 123,
                       164 rows), to t = 8 (about 8 min)
+  validate --fsi1-bands-xy FSI1 with bands in x and y around the body (600 x 123, 760 x 152,
+                      920 x 184), to t = 8 (about 45 min)
   validate --reuse    keep a run whose folder has a summary.json from the identical scene text
 Environment (set by ./fsi validate): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN."""
 import json
@@ -52,6 +54,7 @@ _p.add_argument("--fsi1-level", default="L2", help="FSI1's level (L2)")
 _p.add_argument("--fsi1-only", action="store_true", help="FSI1 alone")
 _p.add_argument("--fsi1-grids", action="store_true", help="FSI1 on four fluid grids")
 _p.add_argument("--fsi1-bands", action="store_true", help="FSI1 on grids with a y band")
+_p.add_argument("--fsi1-bands-xy", action="store_true", help="FSI1 with bands in x and y")
 _p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
 ARGS = _p.parse_args()
 # --ci: L2 only, the frequency judged against the refined values and reported against the 2006
@@ -111,17 +114,20 @@ def scene_text(case, level, dt=None, rho_s=None, t_end=None):
     # A level with a y band keeps the columns (and the cylinder's mesh) of its `nx_rows` uniform
     # rows and lays its n rows out with the band (fluid/README.md, fluid.grid.y_band).
     h = H / lv.get("nx_rows", n)
-    nx = int(round(L / h))
+    nx = lv.get("nx", int(round(L / h)))
+    lc = lv.get("lc", h)
     dt = lv["dt"] if dt is None else dt
     t_end = T_END if t_end is None else t_end
     replace = {
         "name": f'name = "{case}-{level}"',
         "cells": f"cells = [{nx}, {n}]" + (
             "\ny_band = {{ from = {:g}, to = {:g}, cells = {} }}".format(*lv["band"])
-            if "band" in lv else ""),
+            if "band" in lv else "") + (
+            "\nx_band = {{ from = {:g}, to = {:g}, cells = {} }}".format(*lv["x_band"])
+            if "x_band" in lv else ""),
         "dt": f"dt = {dt:.10g}",
         "t_end": f"t_end = {t_end:g}",
-        "mesh_parameters": f'mesh_parameters = "lc = {h:.10g}"',
+        "mesh_parameters": f'mesh_parameters = "lc = {lc:.10g}"',
         "rectangle": "rectangle = { origin = [0.24899, 0.19], size = [0.35101, 0.02], "
                      f"cells = [{lv['bar'][0]}, {lv['bar'][1]}] }}",
     }
@@ -363,6 +369,15 @@ def steady_values(hist):
     return out
 
 
+def print_steady(label, r, wall):
+    """One line of a steady FSI1 study: u_y(A) (its deflection in cells), u_x(A), lift, drag."""
+    print(f"{label}: u_y(A) {1e3 * r['uy']['value']:.4f} mm ({100 * r['uy']['error']:+.1f} %, "
+          f"{r['tip_deflection_in_cells']:.2f} cells), u_x(A) {100 * r['ux']['error']:+.1f} %, "
+          f"lift {r['lift']['value']:.4f} ({100 * r['lift']['error']:+.1f} %), "
+          f"drag {r['drag']['value']:.3f} ({100 * r['drag']['error']:+.1f} %), {wall:.0f} s",
+          flush=True)
+
+
 def fsi1_grids():
     """FSI1 (rho_s = 10 rho_f) on 82, 123, 164 and 246 rows with the same bar mesh (140 x 8): the
     fluid grid changes, and with it lambda = nu dt / h^2 (0.02 ... 0.09). The tip deflection is
@@ -381,11 +396,7 @@ def fsi1_grids():
         r.update(steady_values(hist))
         r["tip_deflection_in_cells"] = r["uy"]["value"] / r["h"]
         rows.append(r)
-        print(f"FSI1 on {n} rows: u_y(A) {1e3 * r['uy']['value']:.4f} mm "
-              f"({100 * r['uy']['error']:+.1f} %, {r['tip_deflection_in_cells']:.2f} cells), "
-              f"lift {r['lift']['value']:.4f} ({100 * r['lift']['error']:+.1f} %), "
-              f"drag {r['drag']['value']:.3f} ({100 * r['drag']['error']:+.1f} %), {wall:.0f} s",
-              flush=True)
+        print_steady(f"FSI1 on {n} rows", r, wall)
     with open(os.path.join(OUT, "fsi1_grids.json"), "w") as f:
         json.dump(rows, f, indent=2)
     fig, ax = plt.subplots(figsize=(5.5, 4))
@@ -428,6 +439,32 @@ def fsi1_bands():
         json.dump(rows, f, indent=2)
 
 
+def fsi1_bands_xy():
+    """FSI1 (rho_s = 10 rho_f, t = 8, bar 140 x 8, as --fsi1-bands) with bands in x and y at once:
+    cells of side hb over x in [0.1, 0.7] and y in [0.14, 0.26] (the cylinder, the bar, its
+    tip's neighbourhood), growing outside (the pressure solve transforms y by its eigenvectors);
+    dt below the explicit diffusion limit hb^2 / (8 nu)."""
+    rows = []
+    for hb, nx, ny, dt in [(0.41 / 246, 600, 123, 2.5e-4), (0.41 / 328, 760, 152, 1.5e-4),
+                           (0.41 / 410, 920, 184, 1e-4)]:
+        level = f"XY{ny}"
+        xb = (0.1, 0.7, int(round(0.6 / hb)))
+        yb = (0.14, 0.26, int(round(0.12 / hb)))
+        LEVELS[level] = {"n": ny, "nx": nx, "lc": hb, "dt": dt, "bar": [140, 8], "band": yb,
+                         "x_band": xb}
+        r_job = job.run(f"fsi1-bands-xy-{nx}x{ny}",
+                        scene_text("fsi1", level, rho_s=10000.0, t_end=8.0), reuse=REUSE)
+        hist = histories(r_job.folder)
+        r = {"cells": [nx, ny], "x_band": xb, "y_band": yb, "h_band": hb,
+             "bar_cells_across": 0.02 / hb, "dt": dt, "wall_s": r_job.wall, "cpu_s": r_job.cpu}
+        r.update(steady_values(hist))
+        r["tip_deflection_in_cells"] = r["uy"]["value"] / hb
+        rows.append(r)
+        print_steady(f"FSI1 on {nx} x {ny}, bands of {1e3 * hb:.3f} mm", r, r_job.wall)
+        with open(os.path.join(OUT, "fsi1_bands_xy.json"), "w") as f:
+            json.dump(rows, f, indent=2)
+
+
 def write_levels(rows):
     with open(os.path.join(OUT, "levels-coarse.md" if COARSE else "levels.md"), "w") as f:
         f.write("Errors against Turek & Hron (2006); in brackets against the refined FEATFLOW values "
@@ -463,6 +500,9 @@ def main():
         return
     if ARGS.fsi1_bands:
         fsi1_bands()
+        return
+    if ARGS.fsi1_bands_xy:
+        fsi1_bands_xy()
         return
     metrics, rows, extra = {}, [], {}
     if not ARGS.fsi1_only:
