@@ -133,7 +133,15 @@ void Coupler::setup() {
   }
 
   if (!m_layout.fibers.empty() && has(Role::fluid)) {
-    m_ib = std::make_unique<FeedbackIB>(m_grid);
+    try {
+      m_ib = std::make_unique<FeedbackIB>(m_grid);
+    } catch (const fsi::Error& e) {
+      // A stretched grid: the scene's fault, named by the keys that stretch it.
+      throw fsi::InputError(fmt::format(
+          "{}: the scene has fibers ([fiber]), and fluid.grid.x_band, y_band, y_stretch or "
+          "fluid.sponge stretches the fluid grid; give the fibers a uniform grid (in {})",
+          e.what(), m_rt.scene().file().string()));
+    }
     if (!m_kappa_given) default_kappa();
   }
   check_can_iterate();
