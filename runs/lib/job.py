@@ -2,7 +2,8 @@
 written into a work folder, the programs it needs come from `build/bin/fsi-plan`, one program runs
 alone and several as one `mpirun` MPMD job (with --oversubscribe, and --allow-run-as-root when
 root). Each run's wall time and CPU time (user + system of the job's processes) are kept in RUNS,
-which metrics.finish() writes to the case's summary.json.
+which metrics.finish() writes to the case's summary.json, and in the run's folder
+(job_time.json), so that a run kept by `reuse` reports them again.
 Environment (set by `./fsi validate`): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN (default mpirun)."""
 import collections
 import json
@@ -73,12 +74,18 @@ def run(name, scene_text, work=None, programs=None, check=True, reuse=False):
     scene = os.path.join(work, name + ".toml")
     folder = os.path.join(work, name)
     done = os.path.join(folder, "summary.json")
+    measured = os.path.join(folder, "job_time.json")  # this module's wall and CPU of the job
     if reuse and os.path.exists(done) and os.path.exists(scene) and open(scene).read() == scene_text:
         with open(done) as f:
             wall = json.load(f).get("wall_time", {})
         wall = max(wall.values()) if isinstance(wall, dict) and wall else float(wall or 0.0)
-        RUNS.append({"name": name, "wall_s": wall, "cpu_s": None, "reused": True})
-        return Run(folder, wall, None, 0, "")
+        cpu = None
+        if os.path.exists(measured):  # the job's own measurement, when this module ran it
+            with open(measured) as f:
+                m = json.load(f)
+            wall, cpu = m["wall_s"], m["cpu_s"]
+        RUNS.append({"name": name, "wall_s": wall, "cpu_s": cpu, "reused": True})
+        return Run(folder, wall, cpu, 0, "")
     with open(scene, "w") as f:
         f.write(scene_text)
     programs = list(programs or roles(scene))
@@ -88,6 +95,9 @@ def run(name, scene_text, work=None, programs=None, check=True, reuse=False):
     wall, cpu = time.time() - t0, _children_cpu() - cpu0
     RUNS.append({"name": name, "programs": programs, "wall_s": wall, "cpu_s": cpu,
                  "exit": r.returncode})
+    if r.returncode == 0 and os.path.isdir(folder):
+        with open(measured, "w") as f:
+            json.dump({"wall_s": wall, "cpu_s": cpu}, f)
     if check and r.returncode != 0:
         sys.stderr.write(r.stdout[-5000:])
         raise SystemExit(f"{name}: the job failed (exit {r.returncode}) on {scene}")

@@ -355,7 +355,7 @@ def bands_xy(levels=None, dts=None, cases=("cfd1", "cfd2"), out="bands_xy.json")
     """CFD1 and CFD2 with bands in x and y (XY_LEVELS), against the benchmark: error against the
     band's spacing and against wall time (bands_xy.json). `dts`: on each level these time steps
     instead of 0.3 hb s/m (the forcing's slip in partly covered cells grows with dt: README).
-    A run kept by --reuse has no CPU time (None): rerun it for the cost plot."""
+    A run kept by --reuse has the CPU time job.py recorded when it ran (none from before that)."""
     rows = []
     for hb, nx, ny in (levels or XY_LEVELS):
         xb = (0.1, 0.7, int(round(0.6 / hb)))
