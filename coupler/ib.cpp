@@ -70,6 +70,11 @@ inline void kernel_run(int i0, int n, bool periodic, int* out) {
 
 }  // namespace
 
+bool FeedbackIB::uniform_grid(const proto::GridInfo& g) {
+  double h;
+  return uniform(g.x_face, h) && uniform(g.y_face, h);
+}
+
 FeedbackIB::FeedbackIB(const proto::GridInfo& g) {
   if (!uniform(g.x_face, m_hx) || !uniform(g.y_face, m_hy))
     fsi::fail("fibers need a uniform fluid grid (the delta function's moment conditions hold on "

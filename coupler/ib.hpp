@@ -31,6 +31,8 @@ class FeedbackIB {
   // The grid must be uniform in each direction where fibers are (checked here for the whole
   // grid: the delta function's moment conditions hold on a uniform grid only).
   explicit FeedbackIB(const proto::GridInfo& grid);
+  // The grid is uniform in both directions (what the constructor needs).
+  static bool uniform_grid(const proto::GridInfo& grid);
 
   // The u- and v-faces within the kernels of markers x (interleaved), dilated by `margin` cells,
   // sorted: the faces whose velocity the coupler asks the fluid for. Faces on a non-periodic

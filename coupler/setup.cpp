@@ -133,15 +133,14 @@ void Coupler::setup() {
   }
 
   if (!m_layout.fibers.empty() && has(Role::fluid)) {
-    try {
-      m_ib = std::make_unique<FeedbackIB>(m_grid);
-    } catch (const fsi::Error& e) {
-      // A stretched grid: the scene's fault, named by the keys that stretch it.
+    if (!FeedbackIB::uniform_grid(m_grid))  // the scene's fault: named by its keys
       throw fsi::InputError(fmt::format(
-          "{}: the scene has fibers ([fiber]), and fluid.grid.x_band, y_band, y_stretch or "
-          "fluid.sponge stretches the fluid grid; give the fibers a uniform grid (in {})",
-          e.what(), m_rt.scene().file().string()));
-    }
+          "fibers need a uniform fluid grid (the delta function's moment conditions hold on a "
+          "uniform grid only): the scene has fibers ([fiber]), and fluid.grid.x_band, y_band, "
+          "y_stretch or fluid.sponge stretches the fluid grid; give the fibers a uniform grid "
+          "(in {})",
+          m_rt.scene().file().string()));
+    m_ib = std::make_unique<FeedbackIB>(m_grid);
     if (!m_kappa_given) default_kappa();
   }
   check_can_iterate();

@@ -50,7 +50,7 @@ Case banded_channel(int nx, int ny) {
   k.cfg.x.band_from = 0.1, k.cfg.x.band_to = 0.7, k.cfg.x.band_cells = nx * 12 / 25;
   k.cfg.y.band_from = 0.14, k.cfg.y.band_to = 0.26, k.cfg.y.band_cells = ny * 72 / 123;
   k.name = fmt::format("banded {}x{}", nx, ny);
-  k.dt = 2.5e-5 * 1500.0 / (2.5 / 0.0016667);
+  k.dt = channel(1500, 246).dt;  // the band's cells are those of the 1500-column channel
   k.direct = false;
   return k;
 }

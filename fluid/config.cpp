@@ -162,19 +162,21 @@ void validate(const Config& c, double dt) {
                        "solver transforms periodic directions, which must be uniform",
                        c.y.tanh_beta));
   }
-  if (x_stretched && y_stretched && c.ranks > 1)
-    bad(c, fmt::format("fluid.ranks = {}: {} and a stretched x ({}) stretch both directions, whose "
-                       "pressure solve runs on one rank; set ranks = 1, or keep one direction uniform",
-                       c.ranks,
-                       c.y.band_cells > 0 ? std::string("fluid.grid.y_band")
-                                          : fmt::format("fluid.grid.y_stretch = {}", c.y.tanh_beta),
-                       x_sponge ? "fluid.sponge" : "fluid.grid.x_band"));
-  if (x_stretched && y_stretched && c.implicit && !c.factored_helmholtz)
-    bad(c, fmt::format("fluid.helmholtz = \"direct\" needs one uniform direction; {} and a stretched "
-                       "x ({}) stretch both: use helmholtz = \"factored\" (the default)",
-                       c.y.band_cells > 0 ? std::string("fluid.grid.y_band")
-                                          : fmt::format("fluid.grid.y_stretch = {}", c.y.tanh_beta),
-                       x_sponge ? "fluid.sponge" : "fluid.grid.x_band"));
+  if (x_stretched && y_stretched) {
+    // What stretches y, and x, for the messages.
+    const std::string ys = c.y.band_cells > 0 ? std::string("fluid.grid.y_band")
+                                              : fmt::format("fluid.grid.y_stretch = {}", c.y.tanh_beta);
+    const char* xs = x_sponge ? "fluid.sponge" : "fluid.grid.x_band";
+    if (c.ranks > 1)
+      bad(c, fmt::format("fluid.ranks = {}: {} and a stretched x ({}) stretch both directions, "
+                         "whose pressure solve runs on one rank; set ranks = 1, or keep one "
+                         "direction uniform",
+                         c.ranks, ys, xs));
+    if (c.implicit && !c.factored_helmholtz)
+      bad(c, fmt::format("fluid.helmholtz = \"direct\" needs one uniform direction; {} and a "
+                         "stretched x ({}) stretch both: use helmholtz = \"factored\" (the default)",
+                         ys, xs));
+  }
   if (x_sponge && px) bad(c, "fluid.sponge: the sponge stretches x, which is periodic");
   if (!(dt > 0)) bad(c, fmt::format("time.dt must be > 0, got {}", dt));
   const double nu = c.viscosity / c.density;
