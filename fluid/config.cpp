@@ -312,6 +312,14 @@ Config read_config(const fsi::SceneTable& f, double dt) {
   if (f.has("body_viscosity"))
     c.bodies_inviscid =
         f.choice("body_viscosity", {"kelvin-voigt", "none"}, "kelvin-voigt") == "none";
+  if (f.has("forcing_time")) {
+    c.forcing_time = f.non_negative("forcing_time");
+    if (c.implicit && c.forcing_in_increment)
+      f.fail("forcing_time", fmt::format("= {} applies to the forcing of the predictor (explicit "
+                                         "diffusion, or implicit_forcing = \"after_solve\"): "
+                                         "remove it or implicit_forcing = \"increment\"",
+                                         c.forcing_time));
+  }
   // Only when given: a scene without it keeps its effective scene as it was.
   if (f.has("upwind_blend")) c.upwind_blend = f.in_range("upwind_blend", 0.0, 1.0, false, 0.0);
   // The launcher's: how many ranks ./fsi gives the fluid (the job's own count decides).

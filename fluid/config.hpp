@@ -87,6 +87,11 @@ struct Config {
   // volume fraction), so that bodies are purely elastic (body_viscosity.cpp); "kelvin-voigt"
   // (the default): the fluid's viscosity everywhere, bodies are Kelvin-Voigt with μ_s = μ_f.
   bool bodies_inviscid = false;
+  // fluid.forcing_time tau >= 0: the immersed forcing's relaxation time (forcing.cpp). A face of
+  // volume fraction alpha is blended by beta = alpha dt / ((1 - alpha) tau + alpha dt), so a
+  // steady flow's slip in a cut face is (1 - alpha)/alpha tau R whatever dt; < 0 (not given):
+  // tau = dt, beta = alpha (paper Eq. 21 as written).
+  double forcing_time = -1;
   // Weight of first-order upwind in the convective fluxes outside the sponge (0: central).
   double upwind_blend = 0;
   int ranks = 0;  // [fluid] ranks: the ranks ./fsi launches the fluid on (0: not given)

@@ -13,6 +13,17 @@ constexpr double kCovered = 1 - 1e-9;
 // the interior and a pressure side's boundary faces). Crank-Nicolson in increment form
 // (predictor.cpp) forced its explicit prediction before the solve (m_pull); here it sets the
 // covered faces to u_s, and f_s is the sum of both.
+//
+// The relaxation time tau (fluid.forcing_time). The predictor carries the pressure gradient of
+// step n, u~ = u^n + dt R (R: convection, diffusion, -grad p^n, body force), so in a steady flow
+// the projection's increment vanishes, u^(n+1) = u^n = u, and a face blended by beta keeps
+//   u = (1 - beta)(u + dt R) + beta u_s   =>   u - u_s = (1 - beta)/beta dt R:
+// with beta = alpha the slip of a cut face grows with dt. Blending by
+//   beta = alpha dt / ((1 - alpha) tau + alpha dt)
+// gives (1 - beta)/beta dt = (1 - alpha)/alpha tau: the slip (1 - alpha)/alpha tau R whatever
+// dt. It is the implicit relaxation u = (u~ + K u_s)/(1 + K), K = alpha dt / ((1 - alpha) tau),
+// so 0 <= beta <= 1 for any dt: a contraction towards u_s, stable for any tau >= 0. tau = dt is
+// Eq. 21; tau = 0 holds every face the body touches at u_s (the limit dt -> 0 of Eq. 21).
 void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out) {
   const double rho = m_cfg.density;
   const int ny = m_grid.ny();
@@ -26,9 +37,14 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
               in.solid_u_index.size(), in.solid_v_index.size());
   // The force on one face, whose velocity is w (alpha a, body velocity ws, pull of the
   // increment's forcing).
+  const double tau = m_cfg.forcing_time;
+  auto blend = [&](double a) {
+    if (tau < 0 || a <= 0) return a;
+    return a >= kCovered ? 1.0 : a * dt / ((1 - a) * tau + a * dt);
+  };
   auto force = [&](double& w, double a, double ws, double pull) {
     if (!cn) {
-      const double f = rho * a * (ws - w) / dt;
+      const double f = rho * blend(a) * (ws - w) / dt;
       w += dt * f / rho;
       return f;
     }

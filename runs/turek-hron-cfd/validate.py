@@ -9,6 +9,9 @@ and the bar (fluid.grid.y_band), against the uniform grids (bands.json; about 12
 `--bands-xy`: CFD1 and CFD2 with bands in both x and y around the body at three spacings
 (XY_LEVELS; bands_xy.json). `--bands-xy-dt`: CFD1 on the first of them at two smaller time steps
 (bands_xy_dt.json).
+`--forcing-time TAU`: fluid.forcing_time = TAU in the scenes (the forcing's slip in cut faces
+set by TAU instead of dt; fluid/forcing.cpp); runs and the --bands-xy JSON named *-tauTAU.
+`--xy-levels K`, `--cases cfd1 ...`: --bands-xy on the first K levels, those cases only.
 `--cost`: error against CPU time of what those wrote (cost.md, cost.png; runs nothing).
 `--reuse`: keep a run whose folder in FSI_OUT has a summary.json from the identical scene text.
 `--helmholtz direct|factored`: fluid.helmholtz in the scenes (factored by default: the key is
@@ -42,6 +45,12 @@ _p.add_argument("--bands-xy-dt", action="store_true",
                 help="CFD1 on the first --bands-xy level at dt 2.5e-4 and 1.25e-4 (--bands-xy: 5e-4)")
 _p.add_argument("--cost", action="store_true",
                 help="error against CPU time of the runs the other modes wrote (cost.md, cost.png)")
+_p.add_argument("--forcing-time", type=float, default=None, metavar="TAU",
+                help="fluid.forcing_time of the scenes (default: not given, tau = dt)")
+_p.add_argument("--xy-levels", type=int, default=None, metavar="K",
+                help="--bands-xy: the first K levels only")
+_p.add_argument("--cases", nargs="+", choices=["cfd1", "cfd2"], default=["cfd1", "cfd2"],
+                help="--bands-xy: these cases only")
 _p.add_argument("--helmholtz", choices=["direct", "factored"], default="factored",
                 help="fluid.helmholtz of the scenes (Crank-Nicolson's Helmholtz solves)")
 ARGS = _p.parse_args()
@@ -50,6 +59,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = job.out_dir("turek-hron-cfd")
 
 H, L = 0.41, 2.5
+TAU_TAG = "" if ARGS.forcing_time is None else f"-tau{ARGS.forcing_time:g}"
 # Reference values: Turek & Hron (2006), CFD1 and CFD2, in reference.csv with their source; both
 # cases are steady in the benchmark.
 def read_reference():
@@ -117,6 +127,8 @@ def scene_text(case, n, dt=None, band=None, name=None, x_band=None, columns=None
             line = f'mesh = "{os.path.join(HERE, "obstacle.geo")}"'
         elif key == "diffusion":
             line += f'\nhelmholtz = "{ARGS.helmholtz}"'
+            if ARGS.forcing_time is not None:
+                line += f"\nforcing_time = {ARGS.forcing_time!r}"
         lines.append(line)
     assert not replace, f"scene {case}.toml lacks keys {list(replace)}"
     return "\n".join(lines) + "\n", dt
@@ -125,7 +137,8 @@ def scene_text(case, n, dt=None, band=None, name=None, x_band=None, columns=None
 def run(name, text):
     """Run fluid + solid + coupler on the scene into OUT/name (OUT/name-direct with the direct
     Helmholtz solves); (folder, wall s, CPU s of the job; None for a reused run)."""
-    r = job.run(name + ("-direct" if ARGS.helmholtz == "direct" else ""), text, reuse=REUSE)
+    r = job.run(name + ("-direct" if ARGS.helmholtz == "direct" else "") + TAU_TAG, text,
+                reuse=REUSE)
     return r.folder, r.wall, r.cpu
 
 
@@ -370,7 +383,7 @@ def bands_xy(levels=None, dts=None, cases=("cfd1", "cfd2"), out="bands_xy.json")
                 t, fx, fy = forces(folder)
                 d, l = analyse(t, fx, 2.0), analyse(t, fy, 2.0)
                 r = {"case": case, "cells": [nx, ny], "x_band": xb, "y_band": yb, "band_h": hb,
-                     "dt": dt, "wall_s": wall, "cpu_s": cpu,
+                     "dt": dt, "forcing_time": ARGS.forcing_time, "wall_s": wall, "cpu_s": cpu,
                      "steps": outputs.summary(folder)["steps"],
                      "drag": d, "lift": l, "drag_error": d["value"] / ref["drag"] - 1.0,
                      "lift_error": l["value"] / ref["lift"] - 1.0}
@@ -378,7 +391,7 @@ def bands_xy(levels=None, dts=None, cases=("cfd1", "cfd2"), out="bands_xy.json")
                 print(f"{case} {nx} x {ny}, bands of {1e3 * hb:.3f} mm, dt {dt:g} ({r['steps']} steps, "
                       f"{wall:.0f} s): drag {d['value']:.4f} ({100 * r['drag_error']:+.2f} %), lift "
                       f"{l['value']:.4f} ({100 * r['lift_error']:+.2f} %)", flush=True)
-                with open(os.path.join(OUT, out), "w") as f:
+                with open(os.path.join(OUT, out.replace(".json", TAU_TAG + ".json")), "w") as f:
                     json.dump(rows, f, indent=2)
 
 
@@ -436,7 +449,7 @@ if __name__ == "__main__":
     elif ARGS.cost:
         cost()
     elif ARGS.bands_xy:
-        bands_xy()
+        bands_xy(levels=XY_LEVELS[:ARGS.xy_levels], cases=tuple(ARGS.cases))
     elif ARGS.bands_xy_dt:
         bands_xy(levels=XY_LEVELS[:1], dts=[2.5e-4, 1.25e-4], cases=("cfd1",),
                  out="bands_xy_dt.json")

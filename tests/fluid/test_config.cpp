@@ -113,6 +113,22 @@ TEST_CASE("upwind_blend: read, and refused outside [0, 1]", "[fluid][config][upw
                     Contains("upwind_blend") && Contains("1.5"));
 }
 
+TEST_CASE("forcing_time: read, refused negative or with the increment forcing",
+          "[fluid][config]") {
+  auto with = [](const std::string& keys) {
+    return replace(kGood, "viscosity = 0.01", "viscosity = 0.01\n" + keys);
+  };
+  CHECK(read(kGood).forcing_time < 0);  // not given: tau = dt
+  CHECK(read(with("forcing_time = 2e-4")).forcing_time == 2e-4);
+  CHECK(read(with("forcing_time = 0")).forcing_time == 0.0);
+  CHECK(read(with("diffusion = \"implicit\"\nforcing_time = 1e-3")).forcing_time == 1e-3);
+  CHECK_THROWS_WITH(read(with("forcing_time = -1e-3")),
+                    Contains("forcing_time") && Contains("-0.001"));
+  CHECK_THROWS_WITH(
+      read(with("diffusion = \"implicit\"\nimplicit_forcing = \"increment\"\nforcing_time = 1e-3")),
+      Contains("forcing_time") && Contains("increment"));
+}
+
 TEST_CASE("implicit_forcing: read with Crank-Nicolson, refused without it or unknown",
           "[fluid][config][implicit]") {
   const std::string cn = replace(kGood, "viscosity = 0.01", "viscosity = 0.01\ndiffusion = \"implicit\"");

@@ -445,3 +445,55 @@ TEST_CASE("body_viscosity = none leaves a rigid rotation alone", "[fluid][coupli
       CHECK(std::abs(force[1][c2][q] - force[0][c2][q]) <= 1e-9 * scale);
   }
 }
+
+namespace {
+// A periodic channel driven by a body force over a wall layer of faces the body holds at rest:
+// the bottom row covered (alpha = 1), the next one cut (alpha = 0.4). The steady u along a
+// column after t_end, at time step dt, with forcing_time tau (< 0: Eq. 21 as written).
+std::vector<double> steady_channel(double dt, double tau) {
+  Config c = box(BcType::periodic);
+  c.body = {2.0, 0.0};
+  c.forcing_time = tau;
+  Solver s(c, dt);
+  const Grid& g = s.grid();
+  std::vector<std::int32_t> iu;
+  std::vector<double> au, uu;
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < g.nu(); ++i) {
+      iu.push_back(i + g.nu() * j);
+      au.push_back(j == 0 ? 1.0 : 0.4);
+      uu.push_back(0.0);
+    }
+  const CouplingIn in = solid_input(iu, au, uu, {}, {}, {});
+  CouplingOut out;
+  const int steps = static_cast<int>(std::lround(150.0 / dt));
+  for (int n = 0; n < steps; ++n) s.step(dt, in, out);
+  std::vector<double> u;
+  for (int j = 0; j < g.ny(); ++j) u.push_back(s.u()(3, j));
+  return u;
+}
+}  // namespace
+
+TEST_CASE("forcing_time: a steady flow's slip in cut faces does not depend on dt",
+          "[fluid][coupling]") {
+  // lambda = nu dt / h^2 = 2.56 dt at h = 1/16: dt = 0.04 and 0.02 (lambda 0.10, 0.05).
+  auto gap = [](const std::vector<double>& a, const std::vector<double>& b) {
+    double d = 0, m = 0;
+    for (std::size_t j = 0; j < a.size(); ++j)
+      d = std::max(d, std::abs(a[j] - b[j])), m = std::max(m, std::abs(a[j]));
+    return d / m;
+  };
+  const auto paper_coarse = steady_channel(0.04, -1), paper_fine = steady_channel(0.02, -1);
+  const auto tau_coarse = steady_channel(0.04, 0.02), tau_fine = steady_channel(0.02, 0.02);
+  // Eq. 21 as written: the cut face slips by (1 - alpha)/alpha dt R, so the profile moves with
+  // dt by a visible fraction.
+  CHECK(gap(paper_coarse, paper_fine) > 1e-3);
+  // With tau: the same steady state at both steps, to the iteration's convergence.
+  CHECK(gap(tau_coarse, tau_fine) < 1e-12);
+  // tau = dt is Eq. 21 (to round-off).
+  CHECK(gap(steady_channel(0.02, 0.02), paper_fine) < 1e-12);
+  // tau = 0 holds the cut face at rest; the flow is the channel above it.
+  const auto pinned = steady_channel(0.04, 0.0);
+  CHECK(std::abs(pinned[1]) < 1e-12 * pinned[4]);
+  CHECK(gap(pinned, steady_channel(0.02, 0.0)) < 1e-12);
+}
