@@ -204,7 +204,13 @@ void ContactSet::detect(const std::vector<const std::vector<double>*>& x,
 // slots now take one normal, n = (n_b - n_a) / |n_b - n_a| (for a: b's side outward; for b:
 // -n), and the gap (a - b) . n: the same constraint twice, which the complementarity solve
 // handles as any two slots on one contact (it keeps one), and the nodes may slide along each
-// other.
+// other. Only when both are in the other's zone: a node outside it, nearest to the vertex
+// itself, has the direction from the vertex as its normal and its distance as its gap (that
+// gradient is exact). Joined with a node in the zone that is behind its edges, the pair took
+// the gap +1.7e-4 where one slot had -5.4e-5 and the other +2.1e-4 (a fold's surface creased,
+// two nodes five apart pressed together: vocal folds, finer cover); the join came and went
+// as the outer node crossed the Voronoi border of the vertex, and Newton cycled between the
+// two gaps through every step cutback.
 void ContactSet::join_vertex_pairs(const std::vector<const std::vector<double>*>& x) {
   for (std::size_t b = 0; b < m_self_slot.size(); ++b) {
     const auto& index = m_self_slot[b];
@@ -218,6 +224,7 @@ void ContactSet::join_vertex_pairs(const std::vector<const std::vector<double>*>
       if (kb <= ka) continue;  // each pair once
       ContactSlot& sb = m_slots[kb];
       if (sb.m0 != sa.slave_node || sb.m1 >= 0) continue;
+      if (!sa.zone || !sb.zone) continue;  // one nearest to the vertex itself (above)
       Vec2 n{sa.normal[0] - sb.normal[0], sa.normal[1] - sb.normal[1]};
       const double ln = std::hypot(n[0], n[1]);
       if (!(ln > 1e-6)) continue;  // normals that cancel: no common direction
@@ -395,6 +402,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     double xi = 0, gap = 0;
     Vec2 normal{0, 0};
     bool vertex = false;
+    bool zone = false;
   };
   Feature closest, through;  // through: the closest guarded feature the node is behind
   const auto& near = surf.self_near[s.slave_node];  // sorted
@@ -453,7 +461,8 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     }
     const Vec2 nv = zone >= 0 ? pseudo_normal(zone) : Vec2{0, 0};
     const double ln = std::hypot(nv[0], nv[1]);
-    if (zone >= 0 && ln > 1e-6) {  // (a vertex whose edges fold back onto each other has none)
+    const bool in_zone = zone >= 0 && ln > 1e-6;
+    if (in_zone) {  // (a vertex whose edges fold back onto each other has no pseudo-normal)
       n = {nv[0] / ln, nv[1] / ln};
       double nearest = std::numeric_limits<double>::max();
       for (int j : surf.vertex_edges[zone]) {
@@ -507,7 +516,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     if (g < -cross && !guard_edge) continue;
     auto offer = [&](Feature& f) {
       if (rank < f.rank * (1 - kClosestTie) || (rank <= f.rank * (1 + kClosestTie) && interior))
-        f = {rank, k, xi, g, n, vertex};
+        f = {rank, k, xi, g, n, vertex, in_zone};
     };
     offer(closest);
     if (guard_edge && g < 0) offer(through);
@@ -519,6 +528,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
   const double best_xi = f.xi, best_gap = f.gap;
   const Vec2 best_normal = f.normal;
   const bool best_vertex = f.vertex;
+  s.zone = best_vertex && f.zone;
   if (best_edge < 0) {
     // No feature: far. An active slot can get here too (its vertex, seen from where the edge
     // next to it is in the node's neighbourhood, is no feature): it is released, since a

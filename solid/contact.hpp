@@ -28,6 +28,9 @@ struct ContactSlot {
   int m0 = -1, m1 = -1;
   double xi = 0;
   Vec2 normal{0, 0};
+  // Self-contact: the feature is a vertex whose zone holds the node, the normal its
+  // pseudo-normal (detect_self); only such slots are joined in pairs (join_vertex_pairs).
+  bool zone = false;
   // Active-set state carried across Newton iterations and steps.
   bool active = false;
   double lambda = 0;  // multiplier, > 0 pushes the bodies apart

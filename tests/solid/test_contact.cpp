@@ -547,6 +547,42 @@ TEST_CASE("self-contact: two nodes at each other's vertex are one contact",
 }
 
 
+// The same two corners, a outside b's zone: a is nearest to the vertex b itself, so its normal is
+// the direction from b and its gap the distance (exact), while b is within a's zone (a's edges,
+// stretched across the slot, make it wide) and has a's pseudo-normal and the distance to a's
+// nearer edge. Joined, the pair took one normal and one gap that neither slot had (a creased
+// vocal fold cycled between the two in Newton).
+TEST_CASE("self-contact: a node outside the other's zone keeps its own gap", "[contact]") {
+  const Mesh mesh = u_mesh();
+  const int a = u_node(mesh, 0.15, 1.0), b = u_node(mesh, 0.35, 1.0);
+  const int below_a = u_node(mesh, 0.15, 0.95);
+  REQUIRE(a >= 0);
+  REQUIRE(b >= 0);
+  REQUIRE(below_a >= 0);
+  ContactSet set;
+  setup_self_contact(set, mesh);
+  auto slot = [&](int n) -> const ContactSlot& { return slot_of(set, n); };
+  std::vector<double> x = mesh.x;
+  const std::vector<double> reach = {0.05};
+  // a above b and a little to the left, 6.1e-4 away (b's zone is 5e-4: edges of 0.05).
+  const double ox = -1e-4, oy = 6e-4, d = std::hypot(ox, oy);
+  x[2 * a] = 0.35 + ox, x[2 * a + 1] = 1.0 + oy;
+  set.detect({&x}, reach);
+  CHECK(slot(a).m0 == b);
+  CHECK(slot(a).m1 == -1);
+  CHECK(slot(a).normal[0] == Approx(ox / d));
+  CHECK(slot(a).normal[1] == Approx(oy / d));
+  CHECK(slot(a).gap == Approx(d));
+  // b at a's vertex, its gap the distance to the edge from a down to below_a (b projects inside
+  // it), outside.
+  CHECK(slot(b).m0 == a);
+  CHECK(slot(b).m1 == -1);
+  const double ex = x[2 * below_a] - x[2 * a], ey = x[2 * below_a + 1] - x[2 * a + 1];
+  const double to_edge = std::abs(-ox * ey - -oy * ex) / std::hypot(ex, ey);
+  CHECK(slot(b).gap == Approx(to_edge));
+  CHECK(std::abs(slot(b).gap - slot(a).gap) > 1e-6);
+}
+
 // A node behind a feature it did not face at the step's start counts as having gone through it
 // only as deep as it and the feature moved since (twice that): deeper, it is the body's other
 // side (a fold tip squeezed thinner than the smallest edge has its nodes behind the edges of
