@@ -47,6 +47,11 @@ void SolidProgram::save(fsi::H5File& h5) const {
   fsi::write_vectors(h5, "solid/contact", s.contact);
   fsi::write_vectors(h5, "solid/root_mass_tangent", s.root_mass_tangent);
   h5.write("solid/slots", slots_to_numbers(s.slots));
+  // Whether each slot's feature is a zone vertex (its zone's radius doubles for the next
+  // detection: contact.cpp). A dataset of its own: files without it read as no zone.
+  std::vector<double> zone;
+  for (const ContactSlot& c : s.slots) zone.push_back(c.zone ? 1.0 : 0.0);
+  h5.write("solid/slot_zone", zone);
   h5.write("solid/clock", std::vector<double>{s.time, s.contact_force_factor});
   h5.write("solid/counts", std::vector<std::int64_t>{s.step, m_steps, m_repeats, m_newton_total,
                                                      m_newton_max, m_cut_steps});
@@ -73,6 +78,13 @@ void SolidProgram::load(const fsi::H5File& h5) {
   s.contact = fsi::read_vectors(h5, "solid/contact");
   s.root_mass_tangent = fsi::read_vectors(h5, "solid/root_mass_tangent");
   s.slots = numbers_to_slots(h5.read_doubles("solid/slots"), h5);
+  if (h5.exists("solid/slot_zone")) {
+    const std::vector<double> zone = h5.read_doubles("solid/slot_zone");
+    if (zone.size() != s.slots.size())
+      fsi::fail("checkpoint {}: {} slot zone flags for {} contact slots", h5.path().string(),
+                zone.size(), s.slots.size());
+    for (std::size_t k = 0; k < zone.size(); ++k) s.slots[k].zone = zone[k] != 0;
+  }
   const auto clock = h5.read_doubles("solid/clock");
   s.time = clock.at(0), s.contact_force_factor = clock.at(1);
   const auto counts = h5.read_int64s("solid/counts");

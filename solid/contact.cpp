@@ -27,7 +27,7 @@ constexpr double kSelfNear = 3;
 // step. A candidate needs a gap below one reach.
 constexpr double kSelfSearch = 4;
 // Self-contact: a node within this fraction of the shorter edge at a vertex (twice that while
-// the vertex is already its feature) touches the vertex, with the vertex's pseudo-normal as the
+// the vertex is already its feature as a zone) touches the vertex, with the vertex's pseudo-normal as the
 // gap's gradient (detect_self).
 constexpr double kSelfVertexZone = 0.01;
 // Self-contact: a node behind a feature it did not face at the step's start is the body's other
@@ -456,7 +456,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
       const auto& ve = surf.vertex_edges[v];
       if (ve.size() != 2) continue;
       const double shortest = std::min(edge_length(ve[0]), edge_length(ve[1]));
-      const double r = kSelfVertexZone * shortest * (s.m1 < 0 && s.m0 == v ? 2 : 1);
+      const double r = kSelfVertexZone * shortest * (s.zone && s.m0 == v ? 2 : 1);
       if (std::hypot(px - x[2 * v], py - x[2 * v + 1]) <= r) zone = v;
     }
     const Vec2 nv = zone >= 0 ? pseudo_normal(zone) : Vec2{0, 0};
