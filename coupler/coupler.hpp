@@ -71,6 +71,7 @@ class Coupler {
   void setup();
   void read_iterations(const fsi::SceneTable& t);
   void check_can_iterate() const;
+  void check_forcing_time() const;
   void write_effective_scene() const;
   std::string body_names() const;
   // The fibers' feedback force (feedback.cpp).

@@ -314,10 +314,13 @@ Config read_config(const fsi::SceneTable& f, double dt) {
         f.choice("body_viscosity", {"kelvin-voigt", "none"}, "kelvin-voigt") == "none";
   if (f.has("forcing_time")) {
     c.forcing_time = f.non_negative("forcing_time");
+    if (!std::isfinite(c.forcing_time))
+      f.fail("forcing_time", fmt::format("must be finite, got {}", c.forcing_time));
     if (c.implicit && c.forcing_in_increment)
-      f.fail("forcing_time", fmt::format("= {} applies to the forcing of the predictor (explicit "
-                                         "diffusion, or implicit_forcing = \"after_solve\"): "
-                                         "remove it or implicit_forcing = \"increment\"",
+      f.fail("forcing_time", fmt::format("= {} applies to the forcing of the predictor, and "
+                                         "implicit_forcing = \"increment\" forces inside the "
+                                         "solve: remove forcing_time, or set implicit_forcing = "
+                                         "\"after_solve\"",
                                          c.forcing_time));
   }
   // Only when given: a scene without it keeps its effective scene as it was.

@@ -124,6 +124,7 @@ TEST_CASE("forcing_time: read, refused negative or with the increment forcing",
   CHECK(read(with("diffusion = \"implicit\"\nforcing_time = 1e-3")).forcing_time == 1e-3);
   CHECK_THROWS_WITH(read(with("forcing_time = -1e-3")),
                     Contains("forcing_time") && Contains("-0.001"));
+  CHECK_THROWS_WITH(read(with("forcing_time = inf")), Contains("forcing_time") && Contains("inf"));
   CHECK_THROWS_WITH(
       read(with("diffusion = \"implicit\"\nimplicit_forcing = \"increment\"\nforcing_time = 1e-3")),
       Contains("forcing_time") && Contains("increment"));

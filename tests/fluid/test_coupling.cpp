@@ -447,29 +447,46 @@ TEST_CASE("body_viscosity = none leaves a rigid rotation alone", "[fluid][coupli
 }
 
 namespace {
-// A periodic channel driven by a body force over a wall layer of faces the body holds at rest:
-// the bottom row covered (alpha = 1), the next one cut (alpha = 0.4). The steady u along a
-// column after t_end, at time step dt, with forcing_time tau (< 0: Eq. 21 as written).
-std::vector<double> steady_channel(double dt, double tau) {
-  Config c = box(BcType::periodic);
-  c.body = {2.0, 0.0};
+// A channel over a wall layer of faces the body holds at rest: the bottom row covered
+// (alpha = 1), the next one cut (alpha = 0.4). Driven by a body force (periodic in x) or by the
+// pressure 0.02 at x = 0 against 0 at x = 1 (pressure sides: the predictor carries grad p^n).
+enum Drive { body_force, pressure_drop };
+Config wall_layer_channel(Drive drive, double tau) {
+  Config c = box(drive == body_force ? BcType::periodic : BcType::pressure);
+  if (drive == body_force)
+    c.body = {2.0, 0.0};
+  else
+    c.bc[left].value = 0.02;
   c.forcing_time = tau;
-  Solver s(c, dt);
-  const Grid& g = s.grid();
-  std::vector<std::int32_t> iu;
-  std::vector<double> au, uu;
-  for (int j = 0; j < 2; ++j)
-    for (int i = 0; i < g.nu(); ++i) {
-      iu.push_back(i + g.nu() * j);
-      au.push_back(j == 0 ? 1.0 : 0.4);
-      uu.push_back(0.0);
-    }
-  const CouplingIn in = solid_input(iu, au, uu, {}, {}, {});
+  return c;
+}
+
+// The layer's faces and the body's velocity (0) on them (the vectors must outlive `in`).
+struct WallLayer {
+  std::vector<std::int32_t> index;
+  std::vector<double> alpha, velocity;
+  CouplingIn in;
+  WallLayer(const WallLayer&) = delete;  // the spans point into this object
+  explicit WallLayer(const Grid& g) {
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < g.nu(); ++i) {
+        index.push_back(i + g.nu() * j);
+        alpha.push_back(j == 0 ? 1.0 : 0.4);
+        velocity.push_back(0.0);
+      }
+    in = solid_input(index, alpha, velocity, {}, {}, {});
+  }
+};
+
+// The steady u along a column after t = 150 at time step dt (< 0 tau: Eq. 21 as written).
+std::vector<double> steady_channel(double dt, double tau, Drive drive = body_force) {
+  Solver s(wall_layer_channel(drive, tau), dt);
+  const WallLayer layer(s.grid());
   CouplingOut out;
   const int steps = static_cast<int>(std::lround(150.0 / dt));
-  for (int n = 0; n < steps; ++n) s.step(dt, in, out);
+  for (int n = 0; n < steps; ++n) s.step(dt, layer.in, out);
   std::vector<double> u;
-  for (int j = 0; j < g.ny(); ++j) u.push_back(s.u()(3, j));
+  for (int j = 0; j < s.grid().ny(); ++j) u.push_back(s.u()(3, j));
   return u;
 }
 }  // namespace
@@ -483,17 +500,43 @@ TEST_CASE("forcing_time: a steady flow's slip in cut faces does not depend on dt
       d = std::max(d, std::abs(a[j] - b[j])), m = std::max(m, std::abs(a[j]));
     return d / m;
   };
-  const auto paper_coarse = steady_channel(0.04, -1), paper_fine = steady_channel(0.02, -1);
-  const auto tau_coarse = steady_channel(0.04, 0.02), tau_fine = steady_channel(0.02, 0.02);
-  // Eq. 21 as written: the cut face slips by (1 - alpha)/alpha dt R, so the profile moves with
-  // dt by a visible fraction.
-  CHECK(gap(paper_coarse, paper_fine) > 1e-3);
-  // With tau: the same steady state at both steps, to the iteration's convergence.
-  CHECK(gap(tau_coarse, tau_fine) < 1e-12);
-  // tau = dt is Eq. 21 (to round-off).
-  CHECK(gap(steady_channel(0.02, 0.02), paper_fine) < 1e-12);
-  // tau = 0 holds the cut face at rest; the flow is the channel above it.
-  const auto pinned = steady_channel(0.04, 0.0);
-  CHECK(std::abs(pinned[1]) < 1e-12 * pinned[4]);
-  CHECK(gap(pinned, steady_channel(0.02, 0.0)) < 1e-12);
+  for (Drive drive : {body_force, pressure_drop}) {
+    CAPTURE(drive);
+    const auto paper_coarse = steady_channel(0.04, -1, drive);
+    const auto paper_fine = steady_channel(0.02, -1, drive);
+    // Eq. 21 as written: the cut face slips by (1 - alpha)/alpha dt R, so the profile moves
+    // with dt by a visible fraction.
+    CHECK(gap(paper_coarse, paper_fine) > 1e-3);
+    // With tau: the same steady state at both steps, to the iteration's convergence.
+    CHECK(gap(steady_channel(0.04, 0.02, drive), steady_channel(0.02, 0.02, drive)) < 1e-12);
+    // tau = 0 holds the cut face at rest; the flow is the channel above it.
+    const auto pinned = steady_channel(0.04, 0.0, drive);
+    CHECK(std::abs(pinned[1]) < 1e-12 * pinned[4]);
+    CHECK(gap(pinned, steady_channel(0.02, 0.0, drive)) < 1e-12);
+  }
+}
+
+TEST_CASE("forcing_time = dt is Eq. 21 step by step, the returned force too",
+          "[fluid][coupling]") {
+  for (Drive drive : {body_force, pressure_drop}) {
+    CAPTURE(drive);
+    const double dt = 0.02;
+    Solver a(wall_layer_channel(drive, -1), dt), b(wall_layer_channel(drive, dt), dt);
+    const WallLayer layer(a.grid());
+    CouplingOut oa, ob;
+    for (int n = 0; n < 5; ++n) {
+      a.step(dt, layer.in, oa);
+      b.step(dt, layer.in, ob);
+    }
+    double du = 0, scale = 0, df = 0, fscale = 0;
+    for (std::size_t k = 0; k < a.u().a.size(); ++k)
+      du = std::max(du, std::abs(a.u().a[k] - b.u().a[k])), scale = std::max(scale, std::abs(a.u().a[k]));
+    for (std::size_t q = 0; q < oa.solid_u_force.size(); ++q)
+      df = std::max(df, std::abs(oa.solid_u_force[q] - ob.solid_u_force[q])),
+      fscale = std::max(fscale, std::abs(oa.solid_u_force[q]));
+    REQUIRE(scale > 0);
+    REQUIRE(fscale > 0);
+    CHECK(du <= 1e-14 * scale);
+    CHECK(df <= 1e-14 * fscale);
+  }
 }
