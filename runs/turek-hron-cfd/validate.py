@@ -18,6 +18,7 @@ set by TAU instead of dt; fluid/forcing.cpp); runs and the --bands-xy JSON named
 always written, so that --reuse never takes a run of the direct solve for one of the factored);
 runs with the direct solve are named *-direct.
 Environment (set by `./fsi validate`): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN."""
+import glob
 import json
 import os
 import sys
@@ -54,6 +55,8 @@ _p.add_argument("--cases", nargs="+", choices=["cfd1", "cfd2"], default=["cfd1",
 _p.add_argument("--helmholtz", choices=["direct", "factored"], default="factored",
                 help="fluid.helmholtz of the scenes (Crank-Nicolson's Helmholtz solves)")
 ARGS = _p.parse_args()
+if ARGS.forcing_time is not None and not ARGS.bands_xy:
+    _p.error("--forcing-time goes with --bands-xy (the other modes' files are not named by it)")
 SHORT, REUSE = ARGS.short, ARGS.reuse
 HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = job.out_dir("turek-hron-cfd")
@@ -391,22 +394,39 @@ def bands_xy(levels=None, dts=None, cases=("cfd1", "cfd2"), out="bands_xy.json")
                 print(f"{case} {nx} x {ny}, bands of {1e3 * hb:.3f} mm, dt {dt:g} ({r['steps']} steps, "
                       f"{wall:.0f} s): drag {d['value']:.4f} ({100 * r['drag_error']:+.2f} %), lift "
                       f"{l['value']:.4f} ({100 * r['lift_error']:+.2f} %)", flush=True)
-                with open(os.path.join(OUT, out.replace(".json", TAU_TAG + ".json")), "w") as f:
-                    json.dump(rows, f, indent=2)
+                write_rows(os.path.join(OUT, out.replace(".json", TAU_TAG + ".json")), rows)
+
+
+def write_rows(path, rows):
+    """rows into the JSON at path, replacing the rows of the same case, grid and dt there and
+    keeping the others (a run of some levels or cases leaves the rest)."""
+    key = lambda r: (r["case"], tuple(r["cells"]), r["dt"])  # noqa: E731
+    new = {key(r) for r in rows}
+    kept = []
+    if os.path.exists(path):
+        with open(path) as f:
+            kept = [r for r in json.load(f) if key(r) not in new]
+    merged = sorted(kept + rows, key=lambda r: (r["case"], r["cells"][0] * r["cells"][1], -r["dt"]))
+    with open(path, "w") as f:
+        json.dump(merged, f, indent=2)
 
 
 def cost():
     """Error against CPU time (and cells) of what the other modes wrote: the uniform grids
     (summary.json's levels), the y band (bands.json), the x and y bands (bands_xy.json,
-    bands_xy_dt.json): cost.md and cost.png. Runs nothing."""
+    bands_xy_dt.json, and with a forcing_time bands_xy-tau*.json): cost.md and cost.png. Runs
+    nothing."""
     groups = []
     summary = os.path.join(OUT, "summary.json")
     if os.path.exists(summary):
         with open(summary) as f:
             levels = json.load(f).get("levels", [])
         groups.append(("uniform", "o-", levels))
+    taus = sorted(glob.glob(os.path.join(OUT, "bands_xy-tau*.json")))
     for name, label, style in [("bands.json", "y band", "s"), ("bands_xy.json", "x and y bands", "^-"),
-                               ("bands_xy_dt.json", "x and y bands, smaller dt", "v")]:
+                               ("bands_xy_dt.json", "x and y bands, smaller dt", "v")] + [
+            (os.path.basename(p), "x and y bands, forcing_time " + p.split("-tau")[-1][:-5], "D-")
+            for p in taus]:
         path = os.path.join(OUT, name)
         if os.path.exists(path):
             with open(path) as f:

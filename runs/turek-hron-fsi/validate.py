@@ -26,8 +26,6 @@ rho_s = 10 rho_f (only the transient differs).
                       164 rows), to t = 8 (about 8 min)
   validate --fsi1-bands-xy FSI1 with bands in x and y around the body (600 x 123, 760 x 152,
                       920 x 184), to t = 8 (about 45 min)
-  validate --fsi1-bands-xy --forcing-time TAU   the same with fluid.forcing_time = TAU (runs and
-                      fsi1_bands_xy-tauTAU.json named so)
   validate --reuse    keep a run whose folder has a summary.json from the identical scene text
 Environment (set by ./fsi validate): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN."""
 import json
@@ -58,15 +56,12 @@ _p.add_argument("--fsi1-grids", action="store_true", help="FSI1 on four fluid gr
 _p.add_argument("--fsi1-bands", action="store_true", help="FSI1 on grids with a y band")
 _p.add_argument("--fsi1-bands-xy", action="store_true", help="FSI1 with bands in x and y")
 _p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
-_p.add_argument("--forcing-time", type=float, default=None, metavar="TAU",
-                help="fluid.forcing_time of the scenes (--fsi1-bands-xy; default: tau = dt)")
 ARGS = _p.parse_args()
 # --ci: L2 only, the frequency judged against the refined values and reported against the 2006
 # table's 2.0 Hz, which this method misses by 3.4-3.5 % on every level (README, "Frequency").
 CI = ARGS.ci
 SHORT = ARGS.short or CI
 REUSE = ARGS.reuse
-TAU_TAG = "" if ARGS.forcing_time is None else f"-tau{ARGS.forcing_time:g}"
 COARSE = ARGS.coarse
 HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = job.out_dir("turek-hron-fsi")
@@ -147,8 +142,6 @@ def scene_text(case, level, dt=None, rho_s=None, t_end=None):
             line = f'mesh = "{os.path.join(HERE, "cylinder.geo")}"'
         elif key == "density" and rho_s is not None and section == "[[solid.body.material]]":
             line = f"density = {rho_s:g}"
-        if line.strip() == "[fluid]" and ARGS.forcing_time is not None:
-            line += f"\nforcing_time = {ARGS.forcing_time!r}"
         lines.append(line)
     assert not replace, f"scene {case}.toml lacks keys {list(replace)}"
     return "\n".join(lines) + "\n" + (ITERATIONS if lv.get("iterations") else "")
@@ -459,17 +452,16 @@ def fsi1_bands_xy():
         yb = (0.14, 0.26, int(round(0.12 / hb)))
         LEVELS[level] = {"n": ny, "nx": nx, "lc": hb, "dt": dt, "bar": [140, 8], "band": yb,
                          "x_band": xb}
-        r_job = job.run(f"fsi1-bands-xy-{nx}x{ny}{TAU_TAG}",
+        r_job = job.run(f"fsi1-bands-xy-{nx}x{ny}",
                         scene_text("fsi1", level, rho_s=10000.0, t_end=8.0), reuse=REUSE)
         hist = histories(r_job.folder)
         r = {"cells": [nx, ny], "x_band": xb, "y_band": yb, "h_band": hb,
-             "bar_cells_across": 0.02 / hb, "dt": dt, "forcing_time": ARGS.forcing_time,
-             "wall_s": r_job.wall, "cpu_s": r_job.cpu}
+             "bar_cells_across": 0.02 / hb, "dt": dt, "wall_s": r_job.wall, "cpu_s": r_job.cpu}
         r.update(steady_values(hist))
         r["tip_deflection_in_cells"] = r["uy"]["value"] / hb
         rows.append(r)
         print_steady(f"FSI1 on {nx} x {ny}, bands of {1e3 * hb:.3f} mm", r, r_job.wall)
-        with open(os.path.join(OUT, f"fsi1_bands_xy{TAU_TAG}.json"), "w") as f:
+        with open(os.path.join(OUT, "fsi1_bands_xy.json"), "w") as f:
             json.dump(rows, f, indent=2)
 
 
