@@ -615,6 +615,40 @@ TEST_CASE("self-contact: behind a feature by more than it moved is the other sid
   CHECK(std::isinf(slot().gap));
 }
 
+// Behind a guarded edge that is not the nearest guarded feature is no crossing: the left arm's
+// top right corner made a little acute (the top edge's other end lowered by 1e-3), a node of
+// the right arm resting on the arm's inner face just below that corner projects inside the top
+// edge and 0.04 behind its line. Having faced the inner face at the step's start, its feature
+// is the inner face (gap 1e-7), not the top edge (-0.04).
+TEST_CASE("self-contact: behind a guarded edge that is not the nearest is no crossing",
+          "[contact]") {
+  const Mesh mesh = u_mesh();
+  const int n = u_node(mesh, 0.35, 1.0), corner = u_node(mesh, 0.15, 1.0);
+  const int top = u_node(mesh, 0.10, 1.0), below = u_node(mesh, 0.15, 0.95);
+  REQUIRE(n >= 0);
+  REQUIRE(corner >= 0);
+  REQUIRE(top >= 0);
+  REQUIRE(below >= 0);
+  ContactSet set;
+  setup_self_contact(set, mesh);
+  auto slot = [&]() -> const ContactSlot& { return slot_of(set, n); };
+  auto on_inner_face = [&]() {  // the edge from below to corner (the body on its left)
+    return slot().m0 == below && slot().m1 == corner;
+  };
+  const std::vector<double> reach = {0.05};
+  std::vector<double> x = mesh.x;
+  x[2 * top + 1] = 0.999;
+  x[2 * n] = 0.16, x[2 * n + 1] = 0.96;  // facing the inner face 0.01 away
+  set.detect({&x}, reach);
+  REQUIRE(on_inner_face());
+  set.remember_fronts({&x});
+  x[2 * n] = 0.15 + 1e-7;
+  set.detect({&x}, reach);
+  CHECK(on_inner_face());
+  CHECK(slot().gap == Approx(1e-7).margin(1e-12));
+  CHECK(slot().normal[0] == Approx(1.0));
+}
+
 // The contact working set's growth (solve_contact): a stiff bar pushed down at its middle, over
 // a fixed rigid block under its left end (near) and a plane under the whole bar (farther). The
 // step without contact moves the bar down as a whole: its left end through the block, the rest
