@@ -314,8 +314,6 @@ Config read_config(const fsi::SceneTable& f, double dt) {
         f.choice("body_viscosity", {"kelvin-voigt", "none"}, "kelvin-voigt") == "none";
   if (f.has("forcing_time")) {
     c.forcing_time = f.non_negative("forcing_time");
-    if (!std::isfinite(c.forcing_time))
-      f.fail("forcing_time", fmt::format("must be finite, got {}", c.forcing_time));
     if (c.implicit && c.forcing_in_increment)
       f.fail("forcing_time", fmt::format("= {} applies to the forcing of the predictor, and "
                                          "implicit_forcing = \"increment\" forces inside the "

@@ -48,7 +48,8 @@ void SolidProgram::save(fsi::H5File& h5) const {
   fsi::write_vectors(h5, "solid/root_mass_tangent", s.root_mass_tangent);
   h5.write("solid/slots", slots_to_numbers(s.slots));
   // Whether each slot's feature is a zone vertex (its zone's radius doubles for the next
-  // detection: contact.cpp). A dataset of its own: files without it read as no zone.
+  // detection: contact.cpp). A dataset of its own: files without it (written before it
+  // existed) read as no zone, so their first step after a resume may differ from the run's.
   std::vector<double> zone;
   for (const ContactSlot& c : s.slots) zone.push_back(c.zone ? 1.0 : 0.0);
   h5.write("solid/slot_zone", zone);

@@ -356,12 +356,13 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
 //   a floor; at most `reach`, and `reach` when no start positions were given) is the body's
 //   other side, not a contact, and is passed over; except the edges at the slot's front
 //   feature (what it faced at the start of the step, remember_fronts) and at its feature while
-//   it is active (the guarded edges). A node behind the nearest guarded feature has gone
-//   through it: that is its feature, even if the body's other side is nearer by then. (Behind
-//   a guarded edge that is not the nearest is no crossing: at a corner of about 90 degrees a
-//   node resting on one edge projects inside the other and behind its line by up to an edge's
-//   length; taken as through, a vocal fold's node touching one edge got a gap of -1.4e-2 from
-//   the next, and Newton cycled.) So a node driven
+//   it is active (the guarded edges). A node behind a guarded feature by no more than it can
+//   have crossed (the bound above), or behind the nearest guarded feature however deep, has
+//   gone through it: that is its feature, even if the body's other side is nearer by then.
+//   (Behind a guarded edge deeper than the node moved, and not the nearest, is no crossing: at
+//   a corner of about 90 degrees a node resting on one edge projects inside the other and
+//   behind its line by up to an edge's length; taken as through, a vocal fold's node touching
+//   one edge got a gap of -1.4e-2 from the next, and Newton cycled.) So a node driven
 //   through the surface it faced within one Newton iteration is still caught in the next; a
 //   node driven through a surface that was not its closest at the step's start, deeper than
 //   that bound, would not be.
@@ -408,7 +409,9 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     bool vertex = false;
     bool zone = false;
   };
-  Feature closest, guarded_near;  // guarded_near: the nearest guarded feature
+  // guarded_near: the nearest guarded feature; crossed: the nearest guarded one the node is
+  // behind by no more than it can have crossed since the step's start.
+  Feature closest, guarded_near, crossed;
   const auto& near = surf.self_near[s.slave_node];  // sorted
   const double search = kSelfSearch * reach;
   const std::vector<double>& start = m_start.size() > static_cast<std::size_t>(s.slave_body)
@@ -524,11 +527,13 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     };
     offer(closest);
     if (guard_edge) offer(guarded_near);
+    if (guard_edge && g < 0 && g >= -cross) offer(crossed);
   }
   // Behind what it faced (or touched): that is the contact, even when the body's other side is
-  // nearer by then.
-  const bool through = guarded_near.edge >= 0 && guarded_near.gap < 0;
-  const Feature& f = through ? guarded_near : closest;
+  // nearer by then. Behind a guarded feature by no more than the node can have crossed since
+  // the step's start (the nearest such), or behind the nearest guarded feature however deep.
+  const bool through_near = guarded_near.edge >= 0 && guarded_near.gap < 0;
+  const Feature& f = crossed.edge >= 0 ? crossed : through_near ? guarded_near : closest;
   const int best_edge = f.edge;
   const double best_xi = f.xi, best_gap = f.gap;
   const Vec2 best_normal = f.normal;

@@ -618,8 +618,8 @@ TEST_CASE("self-contact: behind a feature by more than it moved is the other sid
 // Behind a guarded edge that is not the nearest guarded feature is no crossing: the left arm's
 // top right corner made a little acute (the top edge's other end lowered by 1e-3), a node of
 // the right arm resting on the arm's inner face just below that corner projects inside the top
-// edge and 0.04 behind its line. Having faced the inner face at the step's start, its feature
-// is the inner face (gap 1e-7), not the top edge (-0.04).
+// edge and 0.04 behind its line. Having faced the inner face at the step's start and moved
+// 0.01 since, its feature is the inner face (gap 1e-7), not the top edge (-0.04).
 TEST_CASE("self-contact: behind a guarded edge that is not the nearest is no crossing",
           "[contact]") {
   const Mesh mesh = u_mesh();
@@ -647,6 +647,19 @@ TEST_CASE("self-contact: behind a guarded edge that is not the nearest is no cro
   CHECK(on_inner_face());
   CHECK(slot().gap == Approx(1e-7).margin(1e-12));
   CHECK(slot().normal[0] == Approx(1.0));
+  // The mirror: from above the top edge, facing it, driven through the corner to the same
+  // place within the step (0.05 of motion): behind the top edge by 0.04, less than twice the
+  // motion, so it went through the top edge, though the inner face is nearer and in front.
+  x[2 * n] = 0.14, x[2 * n + 1] = 1.01;
+  set.detect({&x}, reach);
+  REQUIRE(slot().m0 == corner);  // the top edge, from the corner to top (the body on its left)
+  REQUIRE(slot().m1 == top);
+  set.remember_fronts({&x});
+  x[2 * n] = 0.15 + 1e-7, x[2 * n + 1] = 0.96;
+  set.detect({&x}, reach);
+  CHECK(slot().m0 == corner);
+  CHECK(slot().m1 == top);
+  CHECK(slot().gap == Approx(-0.04).epsilon(0.01));
 }
 
 // The contact working set's growth (solve_contact): a stiff bar pushed down at its middle, over
