@@ -38,19 +38,24 @@ CouplingIn solid_input(const std::vector<std::int32_t>& iu, const std::vector<do
   return in;
 }
 
-// Faces (4..7, 3) of a solid block moving at 0.3 with alpha 0.6: the immersed input of the
-// bit-identity tests below (the vectors must outlive the spans of `in`).
-struct BlockInput {
+// An immersed input of u faces only, built face by face (`in` spans the vectors).
+struct UFaceInput {
   std::vector<std::int32_t> index;
   std::vector<double> alpha, velocity;
   CouplingIn in;
-  BlockInput(const BlockInput&) = delete;  // the spans point into this object
+  UFaceInput() = default;
+  UFaceInput(const UFaceInput&) = delete;  // the spans point into this object
+  void add(std::int32_t face, double a, double w) {
+    index.push_back(face), alpha.push_back(a), velocity.push_back(w);
+    in = solid_input(index, alpha, velocity, {}, {}, {});
+  }
+};
+
+// Faces (4..7, 3) of a solid block moving at 0.3 with alpha 0.6: the immersed input of the
+// bit-identity tests below.
+struct BlockInput : UFaceInput {
   explicit BlockInput(const Solver& s) {
-    for (int i = 4; i < 8; ++i)
-      index.push_back(i + s.grid().nu() * 3), alpha.push_back(0.6), velocity.push_back(0.3);
-    in.solid_u_index = index;
-    in.solid_u_alpha = alpha;
-    in.solid_u_velocity = velocity;
+    for (int i = 4; i < 8; ++i) add(i + s.grid().nu() * 3, 0.6, 0.3);
   }
 };
 
@@ -461,20 +466,11 @@ Config wall_layer_channel(Drive drive, double tau) {
   return c;
 }
 
-// The layer's faces and the body's velocity (0) on them (the vectors must outlive `in`).
-struct WallLayer {
-  std::vector<std::int32_t> index;
-  std::vector<double> alpha, velocity;
-  CouplingIn in;
-  WallLayer(const WallLayer&) = delete;  // the spans point into this object
+// The layer's faces and the body's velocity (0) on them.
+struct WallLayer : UFaceInput {
   explicit WallLayer(const Grid& g) {
     for (int j = 0; j < 2; ++j)
-      for (int i = 0; i < g.nu(); ++i) {
-        index.push_back(i + g.nu() * j);
-        alpha.push_back(j == 0 ? 1.0 : 0.4);
-        velocity.push_back(0.0);
-      }
-    in = solid_input(index, alpha, velocity, {}, {}, {});
+      for (int i = 0; i < g.nu(); ++i) add(i + g.nu() * j, j == 0 ? 1.0 : 0.4, 0.0);
   }
 };
 
