@@ -105,13 +105,15 @@ void Coupler::check_forcing_time() const {
   const auto doc = toml::parse<toml::discard_comments, std::map, std::vector>(is, "fluid");
   const auto& fluid = doc.at("fluid");
   if (!fluid.contains("forcing_time")) return;
+  const auto& v = fluid.at("forcing_time");  // 0 in the scene stays an integer
+  const double tau = v.is_integer() ? double(v.as_integer()) : v.as_floating();
   for (const auto& b : m_meshes.bodies)
     if (b.kind == proto::BodyKind::elastic)
       throw fsi::InputError(fmt::format(
-          "fluid.forcing_time = {} is for bodies that take no load (rigid, fixed or with a "
-          "prescribed motion): body '{}' moves under the fluid's load, and its reaction assumes "
+          "fluid.forcing_time = {} is for bodies that take no load (rigid bodies, fixed or with "
+          "a prescribed motion): body '{}' moves under the fluid's load, and its reaction assumes "
           "the forcing of Eq. 21; remove fluid.forcing_time (in {})",
-          toml::get<double>(fluid.at("forcing_time")), b.name, m_rt.scene().file().string()));
+          tau, b.name, m_rt.scene().file().string()));
 }
 
 // Set-up, once: grid from the fluid; meshes and initial state from the solid; layout from the

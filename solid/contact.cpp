@@ -32,7 +32,8 @@ constexpr double kSelfSearch = 4;
 constexpr double kSelfVertexZone = 0.01;
 // Self-contact: a node behind a feature it did not face at the step's start is the body's other
 // side unless it is within this many times its motion since, relative to the feature's point
-// under it (plus the accepted gap, at least kKeepEdge reaches; at most one reach).
+// under it (plus the accepted gap, at least kKeepEdge reaches; at most one reach). Behind a
+// guarded feature within that bound, the node went through it (detect_self).
 constexpr double kSelfCrossing = 2;
 const std::vector<double> kNoPositions;
 
@@ -357,9 +358,11 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
 //   other side, not a contact, and is passed over; except the edges at the slot's front
 //   feature (what it faced at the start of the step, remember_fronts) and at its feature while
 //   it is active (the guarded edges). A node behind a guarded feature by no more than it can
-//   have crossed (the bound above), or behind the nearest guarded feature however deep, has
-//   gone through it: that is its feature, even if the body's other side is nearer by then.
-//   (Behind a guarded edge deeper than the node moved, and not the nearest, is no crossing: at
+//   have crossed (the bound above: twice its motion relative to the feature plus a floor, at
+//   most a reach; the nearest such feature, even if a nearer guarded one has the node in front:
+//   it tunnelled through a corner), or else behind the nearest guarded feature however deep,
+//   has gone through it: that is its feature, even if the body's other side is nearer by then.
+//   (Behind a guarded edge beyond that bound, and not the nearest, is no crossing: at
 //   a corner of about 90 degrees a node resting on one edge projects inside the other and
 //   behind its line by up to an edge's length; taken as through, a vocal fold's node touching
 //   one edge got a gap of -1.4e-2 from the next, and Newton cycled.) So a node driven
