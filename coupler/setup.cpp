@@ -101,12 +101,9 @@ void Coupler::check_can_iterate() const {
 // cut faces over the bent bar, not the inertia, which a steady state does not see.
 void Coupler::check_forcing_time() const {
   if (!has(Role::fluid) || !has(Role::solid)) return;
-  std::istringstream is(m_effective.at("fluid"));
-  const auto doc = toml::parse<toml::discard_comments, std::map, std::vector>(is, "fluid");
-  const auto& fluid = doc.at("fluid");
-  if (!fluid.contains("forcing_time")) return;
-  const auto& v = fluid.at("forcing_time");  // 0 in the scene stays an integer
-  const double tau = v.is_integer() ? double(v.as_integer()) : v.as_floating();
+  const auto fluid = m_rt.root().optional_table("fluid");  // (the fluid checked the key)
+  if (!fluid || !fluid->has("forcing_time")) return;
+  const double tau = fluid->number("forcing_time");
   for (const auto& b : m_meshes.bodies)
     if (b.kind == proto::BodyKind::elastic)
       throw fsi::InputError(fmt::format(
