@@ -360,12 +360,13 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
 //   it is active (the guarded edges). A node behind a guarded feature by no more than it can
 //   have crossed (the bound above: twice its motion relative to the feature plus a floor, at
 //   most a reach; the nearest such feature, even if a nearer guarded one has the node in front:
-//   it tunnelled through a corner), or else behind the nearest guarded feature however deep,
-//   has gone through it: that is its feature, even if the body's other side is nearer by then.
-//   (Behind a guarded edge beyond that bound, and not the nearest, is no crossing: at
-//   a corner of about 90 degrees a node resting on one edge projects inside the other and
-//   behind its line by up to an edge's length; taken as through, a vocal fold's node touching
-//   one edge got a gap of -1.4e-2 from the next, and Newton cycled.) So a node driven
+//   it tunnelled through a corner) and in front of it at the step's start, or else behind the
+//   nearest guarded feature however deep, has gone through it: that is its feature, even if the
+//   body's other side is nearer by then.
+//   (Behind a guarded edge beyond that bound or already at the start, and not the nearest,
+//   is no crossing: at a corner of about 90 degrees a node resting on one edge projects inside
+//   the other and behind its line by up to an edge's length; taken as through, a vocal fold's
+//   node touching one edge got a gap of -1.4e-2 from the next, and Newton cycled.) So a node driven
 //   through the surface it faced within one Newton iteration is still caught in the next; a
 //   node driven through a surface that was not its closest at the step's start, deeper than
 //   that bound, would not be.
@@ -396,6 +397,44 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
       nv[0] += nj[0], nv[1] += nj[1];
     }
     return nv;
+  };
+  // Whether the node was in front of (or on) the feature at the step's start (`start`, the
+  // body's positions then; none given: yes): the feature's point under it then (the vertex, or
+  // the edge's point at the same xi), its normal then (the pseudo-normal, or the edge's), and
+  // the same floor as the crossing bound. Only a node in front then can have gone through it
+  // within the step. Without this test the crossing bound alone decided, and it depends on how
+  // far the node has moved: a node behind a corner's other edge already at the start, by
+  // about twice its motion, took that edge in one Newton iteration and not in the next.
+  auto in_front_at_start = [&](const std::array<int, 2>& e, double xi, bool vertex,
+                               const std::vector<double>& start) {
+    if (start.empty()) return true;
+    auto normal_at = [&](int k) {
+      const auto& ek = mesh.surface[k];
+      const double dx = start[2 * ek[1]] - start[2 * ek[0]], dy = start[2 * ek[1] + 1] - start[2 * ek[0] + 1];
+      const double l = std::hypot(dx, dy);
+      return Vec2{dy / l, -dx / l};
+    };
+    double qx0, qy0;
+    Vec2 n0{0, 0};
+    const double sx = start[2 * s.slave_node], sy = start[2 * s.slave_node + 1];
+    if (vertex) {
+      const int v = xi <= 0 ? e[0] : e[1];
+      for (int j : surf.vertex_edges[v]) {
+        const Vec2 nj = normal_at(j);
+        n0[0] += nj[0], n0[1] += nj[1];
+      }
+      qx0 = sx - start[2 * v], qy0 = sy - start[2 * v + 1];
+    } else {
+      const double w = std::clamp(xi, 0.0, 1.0);
+      const double ax0 = start[2 * e[0]], ay0 = start[2 * e[0] + 1];
+      const double dx = start[2 * e[1]] - ax0, dy = start[2 * e[1] + 1] - ay0;
+      const double l = std::hypot(dx, dy);
+      n0 = {dy / l, -dx / l};
+      qx0 = sx - ax0 - w * dx, qy0 = sy - ay0 - w * dy;
+    }
+    const double ln = std::hypot(n0[0], n0[1]);
+    if (ln <= 1e-6) return true;  // a vertex folded back onto itself: no side to tell
+    return (qx0 * n0[0] + qy0 * n0[1]) / ln >= -std::max(kKeepEdge * reach, m_gap_tol);
   };
   // Nodes whose edges are never passed over as the body's other side.
   const int guard[4] = {front[0], front[1], s.active ? s.m0 : -1, s.active ? s.m1 : -1};
@@ -530,7 +569,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     };
     offer(closest);
     if (guard_edge) offer(guarded_near);
-    if (guard_edge && g < 0 && g >= -cross) offer(crossed);
+    if (guard_edge && g < 0 && g >= -cross && in_front_at_start(e, xi, vertex, start)) offer(crossed);
   }
   // Behind what it faced (or touched): that is the contact, even when the body's other side is
   // nearer by then. Behind a guarded feature by no more than the node can have crossed since

@@ -664,6 +664,27 @@ TEST_CASE("self-contact: behind a guarded edge that is not the nearest is no cro
   CHECK(mslot().m0 == corner);
   CHECK(mslot().m1 == top);
   CHECK(mslot().gap == Approx(-0.04).epsilon(0.01));
+  // Behind the top edge's line already at the step's start, by 0.04, and moving 0.03 (twice
+  // that, capped at the reach, is more than 0.04): the crossing bound alone would take the top
+  // edge (gap −0.04) in this iteration and not in one where the node had moved 0.015. The node
+  // was not in front of the top edge at the start, so it did not go through it: in both, the
+  // inner face it faced.
+  for (const double from : {0.165, 0.18}) {
+    ContactSet far;
+    setup_self_contact(far, mesh);
+    auto fslot = [&]() -> const ContactSlot& { return slot_of(far, n); };
+    x[2 * n] = from, x[2 * n + 1] = 0.96;
+    far.detect({&x}, reach);
+    REQUIRE(fslot().m0 == below);
+    REQUIRE(fslot().m1 == corner);
+    far.remember_fronts({&x});
+    x[2 * n] = 0.15 + 1e-7;
+    far.detect({&x}, reach);
+    INFO("from x = " << from);
+    CHECK(fslot().m0 == below);
+    CHECK(fslot().m1 == corner);
+    CHECK(fslot().gap == Approx(1e-7).margin(1e-12));
+  }
 }
 
 // The contact working set's growth (solve_contact): a stiff bar pushed down at its middle, over
