@@ -130,6 +130,7 @@ class Coupler {
   proto::FiberInput m_fiber_in;
   std::map<std::string, std::string> m_effective;  // role -> its effective scene (TOML)
   std::unique_ptr<ImmersedSolid> m_immersed;
+  double m_footprint_smoothing = 0.0;  // [coupler] footprint_smoothing (SmoothBoxes)
   std::unique_ptr<FeedbackIB> m_ib;
   double m_kappa = 0;         // feedback stiffness (force per length per length), coupler.kappa
   double m_kappa_gain = 0.5;  // the default rule's one-step gain, see default_kappa()

@@ -68,6 +68,51 @@ FaceBoxes FaceBoxes::v_faces(const proto::GridInfo& g) {
   return b;
 }
 
+SmoothBoxes SmoothBoxes::of(const FaceBoxes& faces, double smoothing) {
+  // One direction: boxes e[i]..e[i+1] (i = 0..n-1, box i owned by face i), a ramp of half-width
+  // r[k] about each edge k between two faces (a periodic direction's edge 0 is its edge n).
+  auto direction = [smoothing](const std::vector<double>& e, int n, bool periodic,
+                               std::vector<double>& edges, Axis& axis) {
+    std::vector<double> r(static_cast<std::size_t>(n + 1), 0.0);
+    for (int k = 1; k < n; ++k) r[k] = 0.5 * smoothing * std::min(e[k] - e[k - 1], e[k + 1] - e[k]);
+    if (periodic) r[0] = r[n] = 0.5 * smoothing * std::min(e[1] - e[0], e[n] - e[n - 1]);
+    edges.assign(1, e[0]);
+    auto add = [&](double end, std::array<int, 2> f, std::array<double, 2> w0, std::array<double, 2> w1) {
+      // A flat interval thinner than round-off of the box (ε = 1) is left out.
+      if (end - edges.back() <= 1e-12 * (e[n] - e[0]) / n) return;
+      edges.push_back(end);
+      axis.face.push_back(f), axis.w0.push_back(w0), axis.w1.push_back(w1);
+    };
+    if (periodic && r[0] > 0) add(e[0] + r[0], {n - 1, 0}, {0.5, 0.5}, {0.0, 1.0});
+    for (int i = 0; i < n; ++i) {
+      add(e[i + 1] - r[i + 1], {i, -1}, {1.0, 0.0}, {1.0, 0.0});
+      if (r[i + 1] <= 0) continue;
+      if (i + 1 < n)
+        add(e[i + 1] + r[i + 1], {i, i + 1}, {1.0, 0.0}, {0.0, 1.0});
+      else
+        add(e[n], {n - 1, 0}, {1.0, 0.0}, {0.5, 0.5});
+    }
+    edges.back() = e[n];  // one period exactly, whatever the round-off of the sums
+  };
+  SmoothBoxes s;
+  s.boxes.period_x = faces.period_x;
+  s.boxes.period_y = faces.period_y;
+  direction(faces.ex, faces.ni, faces.period_x > 0, s.boxes.ex, s.ax);
+  direction(faces.ey, faces.nj, faces.period_y > 0, s.boxes.ey, s.ay);
+  s.boxes.ni = static_cast<int>(s.ax.face.size());
+  s.boxes.nj = static_cast<int>(s.ay.face.size());
+  s.boxes.i_lo = 0, s.boxes.i_hi = s.boxes.ni;
+  s.boxes.j_lo = 0, s.boxes.j_hi = s.boxes.nj;
+  return s;
+}
+
+ImmersedSolid::Family::Family(const FaceBoxes& f, double smoothing)
+    : faces(f),
+      smooth(smoothing > 0 ? SmoothBoxes::of(f, smoothing) : SmoothBoxes{}),
+      smoothed(smoothing > 0),
+      ix(clip_boxes().ex),
+      iy(clip_boxes().ey) {}
+
 EdgeIndex::EdgeIndex(const std::vector<double>& e) : m_e(&e) {
   const std::size_t n = e.size() - 1;
   const double h = (e[n] - e[0]) / static_cast<double>(n);
@@ -77,23 +122,36 @@ EdgeIndex::EdgeIndex(const std::vector<double>& e) : m_e(&e) {
   if (m_even) m_inv = 1.0 / h;
 }
 
-ImmersedSolid::ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshes& meshes)
+ImmersedSolid::ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshes& meshes,
+                             double smoothing)
     : m_meshes(meshes),
-      m_ub(FaceBoxes::u_faces(grid)),
-      m_vb(FaceBoxes::v_faces(grid)),
-      m_ux(m_ub.ex),
-      m_uy(m_ub.ey),
-      m_vx(m_vb.ex),
-      m_vy(m_vb.ey) {
-  m_scratch_u.slot.assign(static_cast<std::size_t>(m_ub.ni * m_ub.nj), -1);
-  m_scratch_v.slot.assign(static_cast<std::size_t>(m_vb.ni * m_vb.nj), -1);
+      m_uf(FaceBoxes::u_faces(grid), smoothing),
+      m_vf(FaceBoxes::v_faces(grid), smoothing) {
+  if (!(smoothing >= 0 && smoothing <= 1))
+    fsi::fail("footprint smoothing {} outside [0, 1]", smoothing);
+  m_scratch_u.slot.assign(static_cast<std::size_t>(m_uf.faces.ni * m_uf.faces.nj), -1);
+  m_scratch_v.slot.assign(static_cast<std::size_t>(m_vf.faces.ni * m_vf.faces.nj), -1);
   m_threads = std::thread::hardware_concurrency() > 1;
 }
 
 // Every triangle of body b at positions x, against every box its bounding box meets (and its
 // periodic images).
-void ImmersedSolid::clip_body(const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy,
-                              int b, const std::vector<double>& x, Raw& raw) const {
+//
+// Smoothed (SmoothBoxes), a piece P in interval box (i, j), with local coordinates
+// ξ = (x − ex[i])/(ex[i+1] − ex[i]), η likewise, gives each face of the interval's one or two
+// along x times one or two along y the weight φ = w_x(ξ) w_y(η) (linear in each), and node a of
+// T the weight ∫_P φ N_a dA. The integrand is cubic: P is cut into the triangles of a fan and
+// each is integrated by the four-point rule exact for cubics (weight −27/48 at the centroid,
+// 25/48 at the points with barycentric coordinates (3/5, 1/5, 1/5) and its permutations).
+void ImmersedSolid::clip_body(const Family& fam, int b, const std::vector<double>& x,
+                              Raw& raw) const {
+  const FaceBoxes& boxes = fam.clip_boxes();
+  const FaceBoxes& faces = fam.faces;
+  const EdgeIndex& ix = fam.ix;
+  const EdgeIndex& iy = fam.iy;
+  const bool smoothed = fam.smoothed;
+  const SmoothBoxes::Axis& sax = fam.smooth.ax;
+  const SmoothBoxes::Axis& say = fam.smooth.ay;
   const auto& tri = m_meshes.bodies[b].tri;
   const double sx[3] = {0.0, -boxes.period_x, boxes.period_x};
   const double sy[3] = {0.0, -boxes.period_y, boxes.period_y};
@@ -133,8 +191,47 @@ void ImmersedSolid::clip_body(const FaceBoxes& boxes, const EdgeIndex& ix, const
         const double e2x = t[2].x - t[0].x, e2y = t[2].y - t[0].y;
         const double inv = 1.0 / (e1x * e2y - e2x * e1y);
         const double b11 = e2y * inv, b12 = -e2x * inv, b21 = -e1y * inv, b22 = e1x * inv;
+        // Smoothed: a piece of interval box (i, j) to its faces.
+        auto emit_smooth = [&](const Vec2* poly, int n, int i, int j) {
+          const double x0b = boxes.ex[i], y0b = boxes.ey[j];
+          const double sxb = 1.0 / (boxes.ex[i + 1] - x0b), syb = 1.0 / (boxes.ey[j + 1] - y0b);
+          const auto &fx = sax.face[i], &fy = say.face[j];
+          const auto &ax0 = sax.w0[i], &ax1 = sax.w1[i], &ay0 = say.w0[j], &ay1 = say.w1[j];
+          double w[4][3] = {};
+          auto point = [&](double px, double py, double weight) {
+            const double xi = (px - x0b) * sxb, eta = (py - y0b) * syb;
+            const double wx[2] = {ax0[0] + (ax1[0] - ax0[0]) * xi, ax0[1] + (ax1[1] - ax0[1]) * xi};
+            const double wy[2] = {ay0[0] + (ay1[0] - ay0[0]) * eta, ay0[1] + (ay1[1] - ay0[1]) * eta};
+            const double qx = px - t[0].x, qy = py - t[0].y;
+            const double n1 = b11 * qx + b12 * qy, n2 = b21 * qx + b22 * qy;
+            const double nn[3] = {1.0 - n1 - n2, n1, n2};
+            for (int c = 0; c < 4; ++c) {
+              const double phi = weight * wx[c & 1] * wy[c >> 1];
+              for (int k = 0; k < 3; ++k) w[c][k] += phi * nn[k];
+            }
+          };
+          const Vec2 o = poly[0];
+          for (int k = 1; k + 1 < n; ++k) {
+            const Vec2 p1 = poly[k], p2 = poly[k + 1];
+            const double area = 0.5 * std::abs((p1.x - o.x) * (p2.y - o.y) - (p2.x - o.x) * (p1.y - o.y));
+            if (area == 0) continue;
+            point((o.x + p1.x + p2.x) / 3, (o.y + p1.y + p2.y) / 3, -27.0 / 48.0 * area);
+            const Vec2 v[3] = {o, p1, p2};
+            for (int a3 = 0; a3 < 3; ++a3) {
+              const Vec2 &pa = v[a3], &pb = v[(a3 + 1) % 3], &pc = v[(a3 + 2) % 3];
+              point(0.6 * pa.x + 0.2 * (pb.x + pc.x), 0.6 * pa.y + 0.2 * (pb.y + pc.y), 25.0 / 48.0 * area);
+            }
+          }
+          for (int c = 0; c < 4; ++c) {
+            const int fi = fx[c & 1], fj = fy[c >> 1];
+            if (fi < faces.i_lo || fi >= faces.i_hi || fj < faces.j_lo || fj >= faces.j_hi) continue;
+            if (w[c][0] + w[c][1] + w[c][2] <= 0) continue;
+            raw.push_back({fi + faces.ni * fj, b, {a[0], a[1], a[2]}, {w[c][0], w[c][1], w[c][2]}});
+          }
+        };
         auto emit = [&](const Vec2* poly, int n, int i, int j) {
           if (n < 3) return;
+          if (smoothed) return emit_smooth(poly, n, i, j);
           const PolygonMoments m = polygon_moments(poly, n);
           const double area = std::abs(m.area);
           if (area == 0) return;
@@ -271,8 +368,9 @@ bool ImmersedSolid::fixed_at_rest(const proto::SolidState& state) const {
   return true;
 }
 
-void ImmersedSolid::fill(const FaceBoxes& boxes, const Faces& p, const proto::SolidState& state,
+void ImmersedSolid::fill(const Family& fam, const Faces& p, const proto::SolidState& state,
                          int component, bool fixed_rest, proto::FaceSolid& out) const {
+  const FaceBoxes& boxes = fam.faces;
   const std::size_t nf = p.face.size();
   p.sum.assign(nf, 0.0);
   auto add = [&](const Piece& q, std::int32_t slot) {
@@ -301,31 +399,31 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
   // second thread while this one does the u-family. The solid waits meanwhile; the fluid runs its
   // predictor ahead of its input (one core's worth of work).
   const bool fixed_rest = fixed_at_rest(state);
-  auto family = [&](const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy, Fixed& fixed,
-                    Raw& raw, Faces& p, Scratch& s, int c, proto::FaceSolid& out) {
+  auto family = [&](const Family& fam, Fixed& fixed, Raw& raw, Faces& p, Scratch& s, int c,
+                    proto::FaceSolid& out) {
     if (!m_fixed_done) {
       for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
-        if (bodies[b].kind == proto::BodyKind::rigid_fixed) clip_body(boxes, ix, iy, b, state.x[b], fixed.raw);
+        if (bodies[b].kind == proto::BodyKind::rigid_fixed) clip_body(fam, b, state.x[b], fixed.raw);
       index_fixed(fixed, s);
     }
     raw.clear();
     for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
-      if (bodies[b].kind != proto::BodyKind::rigid_fixed) clip_body(boxes, ix, iy, b, state.x[b], raw);
+      if (bodies[b].kind != proto::BodyKind::rigid_fixed) clip_body(fam, b, state.x[b], raw);
     gather(fixed, raw, p, s);
-    fill(boxes, p, state, c, fixed_rest, out);
+    fill(fam, p, state, c, fixed_rest, out);
   };
   if (m_threads) {
     // An error on either thread reaches the caller (and the error funnel) once both are done.
     std::exception_ptr second_failed;
     std::thread second([&] {
       try {
-        family(m_vb, m_vx, m_vy, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v);
+        family(m_vf, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v);
       } catch (...) {
         second_failed = std::current_exception();
       }
     });
     try {
-      family(m_ub, m_ux, m_uy, m_fixed_u, m_raw_u, m_u, m_scratch_u, 0, u);
+      family(m_uf, m_fixed_u, m_raw_u, m_u, m_scratch_u, 0, u);
     } catch (...) {
       second.join();
       throw;
@@ -333,8 +431,8 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
     second.join();
     if (second_failed) std::rethrow_exception(second_failed);
   } else {
-    family(m_ub, m_ux, m_uy, m_fixed_u, m_raw_u, m_u, m_scratch_u, 0, u);
-    family(m_vb, m_vx, m_vy, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v);
+    family(m_uf, m_fixed_u, m_raw_u, m_u, m_scratch_u, 0, u);
+    family(m_vf, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v);
   }
   m_fixed_done = true;
 }
@@ -344,8 +442,8 @@ void ImmersedSolid::update_velocities(const proto::SolidState& state, proto::Fac
   if (state.v.size() != m_meshes.bodies.size())
     fsi::fail("solid state has {} bodies, the meshes {}", state.v.size(), m_meshes.bodies.size());
   const bool fixed_rest = fixed_at_rest(state);
-  fill(m_ub, m_u, state, 0, fixed_rest, u);
-  fill(m_vb, m_v, state, 1, fixed_rest, v);
+  fill(m_uf, m_u, state, 0, fixed_rest, u);
+  fill(m_vf, m_v, state, 1, fixed_rest, v);
 }
 
 void ImmersedSolid::reaction(const std::vector<double>& fs_u, const std::vector<double>& fs_v,
@@ -371,8 +469,8 @@ void ImmersedSolid::reaction(const std::vector<double>& fs_u, const std::vector<
     for (std::size_t e = 0; e < p.moving->size(); ++e)
       spread((*p.moving)[e], p.sum[p.slot_moving[e]]);
   };
-  add(m_ub, m_u, fs_u, 0);
-  add(m_vb, m_v, fs_v, 1);
+  add(m_uf.faces, m_u, fs_u, 0);
+  add(m_vf.faces, m_v, fs_v, 1);
 }
 
 }  // namespace coupler

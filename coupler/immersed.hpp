@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -29,6 +30,27 @@ struct FaceBoxes {
   // v-face (i, j) at (x_centre[i], y_face[j]): box [x_face[i], x_face[i+1]] × [y_centre[j-1], y_centre[j]].
   static FaceBoxes v_faces(const proto::GridInfo& g);
   double volume(int i, int j) const { return (ex[i + 1] - ex[i]) * (ey[j + 1] - ey[j]); }
+};
+
+// A smoothed footprint (`[coupler] footprint_smoothing = ε`, 0 < ε ≤ 1): each face's weight
+// along a direction is 1 inside its box, ramps linearly to 0 across each box edge over a width
+// ε min(adjacent box widths) centred on the edge, while the neighbour's ramps from 0 to 1: a
+// partition of unity whose integral over each face is its box width (so Σ α |V| is still the
+// body's area). Its weight is the box convolved with a box of width ε h: C⁰, so α varies with
+// C¹ smoothness as a body crosses the grid, where the box's α (ε = 0, paper Sec. 3.2.1) has a kink
+// each time an edge of the body meets a box edge. ε = 1 on a uniform grid is the tent of width
+// 2h. Along each direction the line is cut into intervals, flat (one face, weight 1) or ramps
+// (two faces, linear weights); `boxes` holds the intervals as boxes (ex, ey their edges) and
+// face[k][e], w0[k][e], w1[k][e] (e = 0, 1) each interval's faces (−1: none) and weights at its
+// two ends.
+struct SmoothBoxes {
+  FaceBoxes boxes;
+  struct Axis {
+    std::vector<std::array<int, 2>> face;
+    std::vector<std::array<double, 2>> w0, w1;
+  };
+  Axis ax, ay;
+  static SmoothBoxes of(const FaceBoxes& faces, double smoothing);
 };
 
 // Where a coordinate falls among sorted box edges e[0..n]: last_at_or_below(c) is the largest k
@@ -68,14 +90,18 @@ inline int EdgeIndex::locate(double c) const {
 
 class ImmersedSolid {
  public:
-  ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshes& meshes);
+  // smoothing: `[coupler] footprint_smoothing` ε in [0, 1] (SmoothBoxes); 0, the box.
+  ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshes& meshes,
+                double smoothing = 0.0);
 
   // Before message 2 of a step (common/PROTOCOL.md), from the bodies' current state: for every
   // face whose control volume V meets a body, α = min(1, Σ_bodies |V ∩ body| / |V|) and the
   // mean solid velocity component
   //   ū_s = Σ_T Σ_a u_a ∫_{V∩T} N_a dA / Σ_T |V ∩ T|,
   // exact because N_a is linear on each triangle T: ∫_P N_a dA = |P| N_a(centroid of P).
-  // Rigid fixed bodies are clipped once and reused.
+  // Smoothed (ε > 0), |V ∩ T| becomes ∫_T φ dA and ∫_{V∩T} N_a dA becomes ∫_T φ N_a dA, with φ
+  // the face's weight (SmoothBoxes), whose integral is |V|. Rigid fixed bodies are clipped once
+  // and reused.
   void update(const proto::SolidState& state, proto::FaceSolid& u, proto::FaceSolid& v);
   // The same faces and α as the last update(), ū_s from the velocities of `state` (whose positions
   // must be those of that update): the coupled iterations change only the velocities.
@@ -98,7 +124,8 @@ class ImmersedSolid {
 
  private:
   // One piece V ∩ T: its face, the body and nodes of T, and ∫_{V∩T} N_a dA for the three nodes
-  // (their sum is |V ∩ T|). A family's pieces are kept in clipping order.
+  // (their sum is |V ∩ T|; smoothed: ∫_P φ N_a dA over a piece P of T in one interval box, for
+  // each of its up to four faces). A family's pieces are kept in clipping order.
   struct Piece {
     std::int32_t face, body;
     std::int32_t node[3];
@@ -128,8 +155,18 @@ class ImmersedSolid {
     mutable std::vector<double> sum;     // scratch: per-face sums in fill() and reaction()
     std::vector<std::int32_t> moving_face;  // scratch of gather(): the moving bodies' faces
   };
-  void clip_body(const FaceBoxes& boxes, const EdgeIndex& ix, const EdgeIndex& iy, int b,
-                 const std::vector<double>& x, Raw& raw) const;
+  // One family's clipping: its face boxes, or smoothed its interval boxes.
+  struct Family {
+    FaceBoxes faces;      // the faces and their control volumes
+    SmoothBoxes smooth;   // the smoothed footprint's intervals (unused when ε = 0)
+    bool smoothed;
+    EdgeIndex ix, iy;     // box lookup of the boxes clipped against
+    Family(const FaceBoxes& f, double smoothing);
+    Family(const Family&) = delete;  // ix, iy point into this family's edges
+    Family& operator=(const Family&) = delete;
+    const FaceBoxes& clip_boxes() const { return smoothed ? smooth.boxes : faces; }
+  };
+  void clip_body(const Family& fam, int b, const std::vector<double>& x, Raw& raw) const;
   struct Scratch {  // per face of a family: -1, or its slot while gather() or index_fixed() runs
     std::vector<std::int32_t> slot;
   };
@@ -138,12 +175,11 @@ class ImmersedSolid {
   static void index_fixed(Fixed& f, Scratch& s);
   void gather(const Fixed& fixed, const Raw& moving, Faces& p, Scratch& s);
   bool fixed_at_rest(const proto::SolidState& state) const;
-  void fill(const FaceBoxes& boxes, const Faces& p, const proto::SolidState& state, int component,
+  void fill(const Family& fam, const Faces& p, const proto::SolidState& state, int component,
             bool fixed_rest, proto::FaceSolid& out) const;
 
   const proto::BodyMeshes& m_meshes;
-  FaceBoxes m_ub, m_vb;
-  EdgeIndex m_ux, m_uy, m_vx, m_vy;  // box lookup of each family
+  Family m_uf, m_vf;
   Fixed m_fixed_u, m_fixed_v;  // rigid fixed bodies' pieces, clipped once
   Raw m_raw_u, m_raw_v;
   bool m_fixed_done = false;

@@ -43,6 +43,7 @@ Coupler::Coupler(fsi::Runtime& rt) : m_rt(rt) {
     m_kappa_given = c->has("kappa");
     if (m_kappa_given) m_kappa = c->positive("kappa");
     m_kappa_gain = c->in_range("kappa_gain", 0.0, kMaxKappaGain, true, m_kappa_gain);
+    m_footprint_smoothing = c->in_range("footprint_smoothing", 0.0, 1.0, false, m_footprint_smoothing);
     if (const auto d = c->optional_table("diagnostics")) {
       m_log_csv = d->boolean("exchange", false);
       m_dump_every = d->integer("dump_every", 0);
@@ -175,7 +176,7 @@ void Coupler::setup() {
   if (!bodies.empty()) {
     if (!has(Role::fluid))
       fsi::fail("the scene has solid bodies and fibers but no fluid: nothing couples them");
-    m_immersed = std::make_unique<ImmersedSolid>(m_grid, m_meshes);
+    m_immersed = std::make_unique<ImmersedSolid>(m_grid, m_meshes, m_footprint_smoothing);
     check_bodies_in_domain(0);
     warn_element_sizes();
   }

@@ -26,6 +26,8 @@ rho_s = 10 rho_f (only the transient differs).
                       164 rows), to t = 8 (about 8 min)
   validate --fsi1-bands-xy FSI1 with bands in x and y around the body (600 x 123, 760 x 152,
                       920 x 184), to t = 8 (about 45 min)
+  validate --smoothing FSI2 on L2 with coupler.footprint_smoothing 0, 0.5 and 1: the forces'
+                      grid-crossing jitter against their bias (about 6 min)
   validate --reuse    keep a run whose folder has a summary.json from the identical scene text
 Environment (set by ./fsi validate): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN."""
 import json
@@ -55,6 +57,8 @@ _p.add_argument("--fsi1-only", action="store_true", help="FSI1 alone")
 _p.add_argument("--fsi1-grids", action="store_true", help="FSI1 on four fluid grids")
 _p.add_argument("--fsi1-bands", action="store_true", help="FSI1 on grids with a y band")
 _p.add_argument("--fsi1-bands-xy", action="store_true", help="FSI1 with bands in x and y")
+_p.add_argument("--smoothing", action="store_true",
+                help="FSI2 on L2 with the footprint smoothed (coupler.footprint_smoothing 0, 0.5, 1)")
 _p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
 ARGS = _p.parse_args()
 # --ci: L2 only, the frequency judged against the refined values and reported against the 2006
@@ -108,7 +112,7 @@ WINDOW = 2.0
 TOL = {"amplitude": 0.05, "frequency": 0.03}
 
 
-def scene_text(case, level, dt=None, rho_s=None, t_end=None):
+def scene_text(case, level, dt=None, rho_s=None, t_end=None, smoothing=None):
     lv = LEVELS[level]
     n = lv["n"]
     # A level with a y band keeps the columns (and the cylinder's mesh) of its `nx_rows` uniform
@@ -144,6 +148,9 @@ def scene_text(case, level, dt=None, rho_s=None, t_end=None):
             line = f"density = {rho_s:g}"
         lines.append(line)
     assert not replace, f"scene {case}.toml lacks keys {list(replace)}"
+    if smoothing is not None:
+        k = lines.index("[coupler]")
+        lines.insert(k + 1, f"footprint_smoothing = {smoothing:g}")
     return "\n".join(lines) + "\n" + (ITERATIONS if lv.get("iterations") else "")
 
 
@@ -357,6 +364,62 @@ def dt_limit():
         json.dump(rows, f, indent=2)
 
 
+def jitter(hist, q, window=WINDOW):
+    """The rms over the last `window` seconds of the force minus its 10 ms moving average: the
+    grid-crossing jitter (README, "Force jitter")."""
+    t, y = hist[q]
+    n = max(1, int(round(0.01 / (t[1] - t[0]))))
+    ys = np.convolve(y, np.ones(n) / n, mode="valid")
+    tt, r = t[n // 2:n // 2 + len(ys)], y[n // 2:n // 2 + len(ys)] - ys
+    return float(np.sqrt(np.mean(r[tt >= tt[-1] - window] ** 2)))
+
+
+def smoothing_study():
+    """FSI2 on L2 with the footprint smoothed by eps = 0 (the box, the case's default), 0.5 and 1
+    (coupler/README.md, "Smoothed footprint"): the jitter of the forces against their bias."""
+    rows, fig = [], plt.figure(figsize=(10, 5))
+    ax1, ax2 = fig.add_subplot(2, 1, 1), fig.add_subplot(2, 1, 2)
+    for eps in (0.0, 0.5, 1.0):
+        folder, wall, _ = run(f"fsi2-L2-smoothing-{eps:g}",
+                              scene_text("fsi2", "L2", smoothing=eps if eps > 0 else None))
+        hist = histories(folder)
+        res = {q: analyse(*hist[q]) for q in hist}
+        r = {"smoothing": eps, "wall_s": wall, "results": res,
+             "jitter_rms": {q: jitter(hist, q) for q in ("drag", "lift")}, "errors": {}}
+        for q in ("drag", "lift"):
+            t, y = hist[q]
+            n = max(1, int(round(0.01 / (t[1] - t[0]))))
+            ys = np.convolve(y, np.ones(n) / n, mode="valid")
+            res[q + "_smoothed"] = analyse(t[n // 2:n // 2 + len(ys)], ys)
+        for _, q, _ in QUANTITIES:
+            ref = REF[("fsi2", q)]
+            r["errors"][q] = {"mean": rel(res[q]["mean"], ref["mean"]),
+                              "amplitude": rel(res[q]["amplitude"], ref["amplitude"])}
+        rows.append(r)
+        e = r["errors"]
+        print(f"FSI2 L2, footprint_smoothing {eps:g} ({wall:.0f} s): u_y(A) amplitude "
+              f"{100 * e['uy']['amplitude']:+.1f} %, u_x(A) mean {100 * e['ux']['mean']:+.1f} %; drag "
+              f"{res['drag']['mean']:.1f} +- {res['drag']['amplitude']:.1f} (mean "
+              f"{100 * e['drag']['mean']:+.1f} %, amp {100 * e['drag']['amplitude']:+.1f} %; 10 ms "
+              f"average {res['drag_smoothed']['mean']:.1f} +- {res['drag_smoothed']['amplitude']:.1f}); "
+              f"lift amp {res['lift']['amplitude']:.1f} ({100 * e['lift']['amplitude']:+.1f} %; "
+              f"average {res['lift_smoothed']['amplitude']:.1f}); jitter rms drag "
+              f"{r['jitter_rms']['drag']:.2f}, lift {r['jitter_rms']['lift']:.2f}", flush=True)
+        for ax, q in ((ax1, "drag"), (ax2, "lift")):
+            t, y = hist[q]
+            w = (t >= 11.0) & (t <= 11.3)
+            ax.plot(t[w], y[w], lw=0.8, label=f"eps = {eps:g}")
+            ax.set_ylabel(q)
+    ax1.set_title("FSI2 L2: raw forces with the footprint smoothed by eps (0: the box)")
+    ax1.legend(fontsize=7)
+    ax2.set_xlabel("t [s]")
+    fig.tight_layout()
+    fig.savefig(os.path.join(OUT, "fsi2_smoothing.png"), dpi=110)
+    plt.close(fig)
+    with open(os.path.join(OUT, "fsi2_smoothing.json"), "w") as f:
+        json.dump(rows, f, indent=2)
+
+
 def steady_values(hist):
     """FSI1's last values against the benchmark, with their change over the last 0.5 s."""
     out = {}
@@ -503,6 +566,9 @@ def main():
         return
     if ARGS.fsi1_bands_xy:
         fsi1_bands_xy()
+        return
+    if ARGS.smoothing:
+        smoothing_study()
         return
     metrics, rows, extra = {}, [], {}
     if not ARGS.fsi1_only:

@@ -390,3 +390,176 @@ TEST_CASE("overlapping bodies: alpha capped at 1, the mean velocity weighted by 
   CHECK(std::abs(b.fx) <= 1e-12 * b.scale);
   CHECK(std::abs(b.fy) <= 1e-12 * b.scale);
 }
+
+// The smoothed footprint (`[coupler] footprint_smoothing = ε`): each face's weight is its box
+// convolved with a box of width ε h, a partition of unity; ε = 1 on a uniform grid is the tent of
+// width 2h.
+namespace {
+
+// ∫_{-1}^{d} (1 − |s|) ds: the fraction of a unit tent below d.
+double tent_below(double d) {
+  if (d <= -1) return 0;
+  if (d >= 1) return 1;
+  return d <= 0 ? 0.5 * (1 + d) * (1 + d) : 1 - 0.5 * (1 - d) * (1 - d);
+}
+
+// The fraction below d (in cells from the face) of the box of width 1 convolved with a box of
+// width e: flat within (1 − e)/2 of the face, ramps of width e about ±1/2.
+double smoothed_below(double d, double e) {
+  auto ramp = [e](double x) {  // ∫_{-∞}^{x} of a ramp rising over [-e/2, e/2]: C¹
+    if (x <= -e / 2) return 0.0;
+    if (x >= e / 2) return x;
+    return (x + e / 2) * (x + e / 2) / (2 * e);
+  };
+  return ramp(d + 0.5) - ramp(d - 0.5);
+}
+
+}  // namespace
+
+TEST_CASE("smoothed footprint: the weights add up to the body's area, for u- and v-faces") {
+  struct Case {
+    const char* name;
+    proto::GridInfo g;
+    proto::BodyMesh body;
+    double area;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"rotated square", grid(32, 24, 1.0, 0.75, false, false),
+                   rectangle(0.3, 0.3, 7, 7, 0.37, {0.47, 0.39}), 0.09});
+  double disk_area = 0;
+  auto d = disk(0.17, 6, {0.52, 0.4}, &disk_area);
+  cases.push_back({"disk", grid(40, 32, 1.0, 0.8, false, false), d, disk_area});
+  cases.push_back({"across the periodic boundaries", grid(32, 32, 1.0, 1.0, true, true),
+                   rectangle(0.4, 0.25, 9, 5, 0.2, {0.97, 0.02}), 0.1});
+  cases.push_back({"travelled several periods", grid(32, 32, 1.0, 1.0, true, true),
+                   rectangle(0.4, 0.25, 9, 5, 0.2, {0.97 + 2.0, 0.02 - 3.0}), 0.1});
+  cases.push_back({"stretched grid", [] {
+                     auto g = grid(30, 20, 1.0, 1.0, true, false);
+                     for (int j = 0; j <= 20; ++j) g.y_face[j] = std::pow(j / 20.0, 1.5);
+                     return g;
+                   }(),
+                   rectangle(0.5, 0.3, 10, 6, -0.6, {0.5, 0.5}), 0.15});
+  for (const double eps : {0.5, 1.0}) {
+    for (auto& c : cases) {
+      SECTION(c.name + std::string(eps == 1.0 ? ", eps 1" : ", eps 0.5")) {
+        proto::BodyMeshes m;
+        m.bodies.push_back(c.body);
+        ImmersedSolid is(c.g, m, eps);
+        proto::FaceSolid u, v;
+        is.update(at_rest(m), u, v);
+        CHECK(std::abs(sum_alpha_volume(FaceBoxes::u_faces(c.g), u) - c.area) <= 1e-12 * c.area);
+        CHECK(std::abs(sum_alpha_volume(FaceBoxes::v_faces(c.g), v) - c.area) <= 1e-12 * c.area);
+        CHECK(std::abs(is.area_u() - c.area) <= 1e-12 * c.area);
+        for (double a : u.alpha) CHECK((a > 0 && a <= 1.0));
+        // The weights reach a face further than its box does: more faces take part.
+        ImmersedSolid box(c.g, m);
+        proto::FaceSolid ub, vb;
+        box.update(at_rest(m), ub, vb);
+        CHECK(u.index.size() > ub.index.size());
+      }
+    }
+  }
+}
+
+TEST_CASE("smoothed footprint: alpha at a straight edge is the weight's share below it") {
+  // A block whose top edge y = y0 lies off the grid lines; faces well inside its x extent see
+  // the half-plane y < y0.
+  const auto g = grid(20, 20, 1.0, 1.0, false, false);
+  const double h = 0.05, y0 = 0.5 + 0.37 * h;
+  proto::BodyMeshes m;
+  m.bodies.push_back(rectangle(0.6, 0.3, 12, 6, 0.0, {0.5, y0 - 0.15}));
+  for (const double eps : {0.3, 1.0}) {
+    ImmersedSolid is(g, m, eps);
+    proto::FaceSolid u, v;
+    is.update(at_rest(m), u, v);
+    int checked = 0;
+    for (int comp = 0; comp < 2; ++comp) {
+      const auto faces = comp == 0 ? FaceBoxes::u_faces(g) : FaceBoxes::v_faces(g);
+      const auto& fs = comp == 0 ? u : v;
+      for (std::size_t k = 0; k < fs.index.size(); ++k) {
+        const int i = fs.index[k] % faces.ni, j = fs.index[k] / faces.ni;
+        const double xf = comp == 0 ? i * h : (i + 0.5) * h, yf = comp == 0 ? (j + 0.5) * h : j * h;
+        if (xf < 0.3 || xf > 0.7 || yf < y0 - 2 * h) continue;
+        const double d = (y0 - yf) / h;
+        CHECK(std::abs(fs.alpha[k] - smoothed_below(d, eps)) <= 1e-13);
+        if (eps == 1.0) CHECK(std::abs(fs.alpha[k] - tent_below(d)) <= 1e-13);
+        ++checked;
+      }
+    }
+    CHECK(checked >= 4 * 8);  // two rows of u-faces and two of v-faces meet the edge
+  }
+}
+
+TEST_CASE("smoothed footprint: alpha is continuously differentiable as a body crosses the grid") {
+  // A block slides up by h/100 per step across two cells; the second difference of a face's α
+  // is at most (δ/h)²/ε (the weight's α'' is at most 1/(ε h²)), while the box's α has kinks
+  // where the edge meets a box edge (a second difference of δ/h).
+  const auto g = grid(20, 20, 1.0, 1.0, false, false);
+  const double h = 0.05, delta = h / 100;
+  proto::BodyMeshes m;
+  m.bodies.push_back(rectangle(0.6, 0.3, 12, 6, 0.0, {0.5, 0.35}));
+  auto alpha_of = [&](double eps, double shift, int comp) {
+    auto s = at_rest(m);
+    for (std::size_t k = 1; k < s.x[0].size(); k += 2) s.x[0][k] += shift;
+    ImmersedSolid is(g, m, eps);
+    proto::FaceSolid u, v;
+    is.update(s, u, v);
+    const auto faces = comp == 0 ? FaceBoxes::u_faces(g) : FaceBoxes::v_faces(g);
+    const auto& fs = comp == 0 ? u : v;
+    for (std::size_t k = 0; k < fs.index.size(); ++k)
+      if (fs.index[k] == 10 + faces.ni * 10) return fs.alpha[k];  // the face at or near (0.5, 0.5)
+    return 0.0;
+  };
+  for (int comp = 0; comp < 2; ++comp) {
+    for (const double eps : {0.0, 0.5, 1.0}) {
+      double worst = 0;
+      for (int n = 1; n < 200; ++n)
+        worst = std::max(worst, std::abs(alpha_of(eps, (n + 1) * delta, comp) -
+                                         2 * alpha_of(eps, n * delta, comp) +
+                                         alpha_of(eps, (n - 1) * delta, comp)));
+      if (eps == 0.0)
+        CHECK(worst >= 0.4 * delta / h);
+      else
+        CHECK(worst <= 1.0001 * (delta / h) * (delta / h) / eps);
+    }
+  }
+}
+
+TEST_CASE("smoothed footprint: the mean velocity of a linear field and action = reaction") {
+  const auto g = grid(24, 20, 1.2, 1.0, false, false);
+  const double h = 0.05;
+  proto::BodyMeshes m;
+  m.bodies.push_back(rectangle(0.5, 0.35, 9, 6, 0.41, {0.61, 0.48}));
+  auto s = at_rest(m);
+  const double a11 = 1.5, a12 = 0.7, a21 = -0.4, a22 = -1.1, b1 = 0.3, b2 = -0.1;
+  for (std::size_t k = 0; k < s.x[0].size(); k += 2) {
+    const double x = s.x[0][k], y = s.x[0][k + 1];
+    s.v[0][k] = a11 * x + a12 * y + b1;
+    s.v[0][k + 1] = a21 * x + a22 * y + b2;
+  }
+  for (const double eps : {0.5, 1.0}) {
+    ImmersedSolid is(g, m, eps);
+    proto::FaceSolid u, v;
+    is.update(s, u, v);
+    // A face whose whole weight lies in the body: the weight is symmetric about the face, so the
+    // mean of a linear field over it is the field at the face.
+    int inside = 0;
+    for (int comp = 0; comp < 2; ++comp) {
+      const auto faces = comp == 0 ? FaceBoxes::u_faces(g) : FaceBoxes::v_faces(g);
+      const auto& fs = comp == 0 ? u : v;
+      for (std::size_t k = 0; k < fs.index.size(); ++k) {
+        if (fs.alpha[k] < 1 - 1e-12) continue;
+        const int i = fs.index[k] % faces.ni, j = fs.index[k] / faces.ni;
+        const double x = comp == 0 ? i * h : (i + 0.5) * h, y = comp == 0 ? (j + 0.5) * h : j * h;
+        const double exact = comp == 0 ? a11 * x + a12 * y + b1 : a21 * x + a22 * y + b2;
+        CHECK(std::abs(fs.velocity[k] - exact) <= 1e-12);
+        ++inside;
+      }
+    }
+    CHECK(inside > 20);
+    std::mt19937 rng(3);
+    const auto bal = action_plus_reaction(g, is, u, v, rng);
+    CHECK(std::abs(bal.fx) <= 1e-12 * bal.scale);
+    CHECK(std::abs(bal.fy) <= 1e-12 * bal.scale);
+  }
+}
