@@ -167,11 +167,6 @@ void validate(const Config& c, double dt) {
     const std::string ys = c.y.band_cells > 0 ? std::string("fluid.grid.y_band")
                                               : fmt::format("fluid.grid.y_stretch = {}", c.y.tanh_beta);
     const char* xs = x_sponge ? "fluid.sponge" : "fluid.grid.x_band";
-    if (c.ranks > 1)
-      bad(c, fmt::format("fluid.ranks = {}: {} and a stretched x ({}) stretch both directions, "
-                         "whose pressure solve runs on one rank; set ranks = 1, or keep one "
-                         "direction uniform",
-                         c.ranks, ys, xs));
     if (c.implicit && !c.factored_helmholtz)
       bad(c, fmt::format("fluid.helmholtz = \"direct\" needs one uniform direction; {} and a "
                          "stretched x ({}) stretch both: use helmholtz = \"factored\" (the default)",

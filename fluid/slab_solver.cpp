@@ -112,17 +112,34 @@ SlabSolver::SlabSolver(const Operator1D& t, const Operator1D& s, double sigma, i
   // A transpose sends this rank's values but its own block: about (P - 1) / P of its share.
   m_bytes_per_transpose = 8.0 * double(rows) * ncol / ranks * (ranks - 1) / ranks;
 
-  if (!t.a.empty())
-    fsi::fail("fluid::SlabSolver: a stretched transform direction (both directions stretched) "
-              "is solved on one rank only");
-  const TransformPair kt = transform_pair(m_nt, t.lo, t.hi);
-  m_lt = eigenvalues(m_nt, t.h, t.lo, t.hi);
-  m_norm = kt.norm;
+  // A stretched t (both directions stretched): its eigenvectors as dense products on the
+  // t-lines, as FastSolver takes them (eigen_transform; the same matrices on every rank, so each
+  // line's result is the one-rank solve's).
+  const bool stretched_t = !t.a.empty();
+  if (stretched_t && m_transform_s)
+    fsi::fail("fluid::SlabSolver: a stretched transform direction beside a periodic one");
+  EigenTransform et;
+  TransformPair kt{};
+  if (stretched_t) {
+    et = eigen_transform(t);
+    m_lt = et.lambda;
+    m_norm = 1;
+  } else {
+    kt = transform_pair(m_nt, t.lo, t.hi);
+    m_lt = eigenvalues(m_nt, t.h, t.lo, t.hi);
+    m_norm = kt.norm;
+  }
   int stride;  // the local wavenumbers' count in the layout of the solve along s
   // The t-transforms as FastSolver takes them (FFTW's plan or the matrix product; each line's
   // result is the same either way on any split), on this rank's t-lines.
   auto t_lines = [&](int count, int dist, double* p) {
     m_t_lines = p;
+    if (stretched_t) {
+      if (count <= 0) return;
+      m_dense_fwd = std::make_unique<DenseTransform>(et.fwd, m_nt, count, dist, false);
+      m_dense_bwd = std::make_unique<DenseTransform>(et.bwd, m_nt, count, dist, false);
+      return;
+    }
     m_t_fwd = lines_plan(m_nt, count, p, 1, dist, kt.fwd);
     m_t_bwd = lines_plan(m_nt, count, p, 1, dist, kt.bwd);
     m_dense_fwd = DenseTransform::if_preferred(kt.fwd, m_nt, count, dist);

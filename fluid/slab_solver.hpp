@@ -18,8 +18,9 @@
 //   1. transpose rows x s to s x rows: every y line whole on a rank, 2. transform the y lines,
 //   3. transpose back, kept as s x (local rows), 4. Thomas along x per local wavenumber (or the
 //   x transform when x is periodic), 5.-7. the transposes and the back-transform in reverse.
-// Every arithmetic operation on a value is that of FastSolver, so the result equals the
-// one-rank solve up to the transforms' round-off.
+// A stretched t (both directions stretched: t = y) takes FastSolver's dense eigenvector products
+// in place of the FFTs, on the same lines. Every arithmetic operation on a value is that of
+// FastSolver, so the result equals the one-rank solve up to the transforms' round-off.
 #pragma once
 
 #include <fftw3-mpi.h>

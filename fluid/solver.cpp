@@ -127,15 +127,8 @@ Solver::Solver(const Config& c, double dt, MPI_Comm comm)
   validate(c, dt);
   m_nu = c.viscosity / c.density;
   const int nx = m_grid.nx(), ny = m_grid.ny();
-  // The transform axis: x where it is uniform, else y (stretched too: its eigenvectors, one rank).
+  // The transform axis: x where it is uniform, else y (stretched too: its eigenvectors).
   m_t_axis = m_grid.x().uniform() ? 0 : 1;
-  if (!m_grid.x().uniform() && !m_grid.y().uniform() && !m_dec.serial())
-    throw fsi::InputError(fmt::format(
-        "the fluid runs on {} ranks, but its grid is stretched in x (fluid.grid.x_band or "
-        "fluid.sponge) and in y (fluid.grid.y_band or y_stretch), and that pressure solve runs "
-        "on one rank; launch the fluid on one rank (fluid.ranks = 1), or keep one direction "
-        "uniform (in {})",
-        m_dec.ranks(), c.source));
   m_i0 = m_grid.x().periodic() ? 0 : 1;
   m_j0 = m_grid.y().periodic() ? 0 : 1;
   m_iu0 = m_bnd.is_pressure(left) ? 0 : m_i0;

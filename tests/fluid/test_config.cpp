@@ -258,15 +258,14 @@ TEST_CASE("bands that cannot be laid out are refused with the key", "[fluid][con
                     Contains("cells") && Contains("more than the direction's 16 cells"));
   CHECK_THROWS_WITH(with("y_band = { from = 0.4, to = 0.6, cells = 4 }\ny_stretch = 1.2"),
                     Contains("fluid.grid.y_band with fluid.grid.y_stretch"));
-  // Bands in both directions are read (the transform then runs along y by its eigenvectors), but
-  // the direct Crank-Nicolson solve needs one uniform direction.
+  // Bands in both directions are read (the transform then runs along y by its eigenvectors, on
+  // any number of ranks), but the direct Crank-Nicolson solve needs one uniform direction.
   const std::string both =
       "y_band = { from = 0.4, to = 0.6, cells = 4 }\nx_band = { from = 0.5, to = 1.0, cells = 8 }";
   CHECK(with(both).x.band_cells == 8);
-  CHECK_THROWS_WITH(
-      read(replace(replace(walls, "size = [2.0, 1.0]", "size = [2.0, 1.0]\n" + both),
-                   "viscosity = 0.01", "viscosity = 0.01\nranks = 2")),
-      Contains("fluid.ranks = 2") && Contains("one rank") && Contains("fluid_config_test.toml"));
+  CHECK(read(replace(replace(walls, "size = [2.0, 1.0]", "size = [2.0, 1.0]\n" + both),
+                     "viscosity = 0.01", "viscosity = 0.01\nranks = 2"))
+            .ranks == 2);
   CHECK_THROWS_WITH(
       read(replace(replace(walls, "size = [2.0, 1.0]", "size = [2.0, 1.0]\n" + both),
                    "viscosity = 0.01", "viscosity = 0.01\ndiffusion = \"implicit\"\nhelmholtz = \"direct\"")),
