@@ -122,13 +122,19 @@ EdgeIndex::EdgeIndex(const std::vector<double>& e) : m_e(&e) {
   if (m_even) m_inv = 1.0 / h;
 }
 
+namespace {
+double checked_smoothing(double smoothing) {
+  if (!(smoothing >= 0 && smoothing <= 1))
+    fsi::fail("footprint smoothing {} outside [0, 1]", smoothing);
+  return smoothing;
+}
+}  // namespace
+
 ImmersedSolid::ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshes& meshes,
                              double smoothing)
     : m_meshes(meshes),
-      m_uf(FaceBoxes::u_faces(grid), smoothing),
+      m_uf(FaceBoxes::u_faces(grid), checked_smoothing(smoothing)),
       m_vf(FaceBoxes::v_faces(grid), smoothing) {
-  if (!(smoothing >= 0 && smoothing <= 1))
-    fsi::fail("footprint smoothing {} outside [0, 1]", smoothing);
   m_scratch_u.slot.assign(static_cast<std::size_t>(m_uf.faces.ni * m_uf.faces.nj), -1);
   m_scratch_v.slot.assign(static_cast<std::size_t>(m_vf.faces.ni * m_vf.faces.nj), -1);
   m_threads = std::thread::hardware_concurrency() > 1;
@@ -199,7 +205,9 @@ void ImmersedSolid::clip_body(const Family& fam, int b, const std::vector<double
           const auto &ax0 = sax.w0[i], &ax1 = sax.w1[i], &ay0 = say.w0[j], &ay1 = say.w1[j];
           double w[4][3] = {};
           auto point = [&](double px, double py, double weight) {
-            const double xi = (px - x0b) * sxb, eta = (py - y0b) * syb;
+            // (clamped: a point on the piece's border may fall a round-off outside the box)
+            const double xi = std::clamp((px - x0b) * sxb, 0.0, 1.0);
+            const double eta = std::clamp((py - y0b) * syb, 0.0, 1.0);
             const double wx[2] = {ax0[0] + (ax1[0] - ax0[0]) * xi, ax0[1] + (ax1[1] - ax0[1]) * xi};
             const double wy[2] = {ay0[0] + (ay1[0] - ay0[0]) * eta, ay0[1] + (ay1[1] - ay0[1]) * eta};
             const double qx = px - t[0].x, qy = py - t[0].y;
@@ -211,10 +219,12 @@ void ImmersedSolid::clip_body(const Family& fam, int b, const std::vector<double
             }
           };
           const Vec2 o = poly[0];
+          double piece_area = 0;
           for (int k = 1; k + 1 < n; ++k) {
             const Vec2 p1 = poly[k], p2 = poly[k + 1];
             const double area = 0.5 * std::abs((p1.x - o.x) * (p2.y - o.y) - (p2.x - o.x) * (p1.y - o.y));
             if (area == 0) continue;
+            piece_area += area;
             point((o.x + p1.x + p2.x) / 3, (o.y + p1.y + p2.y) / 3, -27.0 / 48.0 * area);
             const Vec2 v[3] = {o, p1, p2};
             for (int a3 = 0; a3 < 3; ++a3) {
@@ -225,7 +235,9 @@ void ImmersedSolid::clip_body(const Family& fam, int b, const std::vector<double
           for (int c = 0; c < 4; ++c) {
             const int fi = fx[c & 1], fj = fy[c >> 1];
             if (fi < faces.i_lo || fi >= faces.i_hi || fj < faces.j_lo || fj >= faces.j_hi) continue;
-            if (w[c][0] + w[c][1] + w[c][2] <= 0) continue;
+            // A face whose weight vanishes on the piece (a sliver at a ramp's end) takes none of
+            // it: its few digits left would make ū_s = Σ w u / Σ w arbitrary.
+            if (w[c][0] + w[c][1] + w[c][2] <= 1e-12 * piece_area) continue;
             raw.push_back({fi + faces.ni * fj, b, {a[0], a[1], a[2]}, {w[c][0], w[c][1], w[c][2]}});
           }
         };

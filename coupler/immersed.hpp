@@ -36,10 +36,10 @@ struct FaceBoxes {
 // along a direction is 1 inside its box, ramps linearly to 0 across each box edge over a width
 // ε min(adjacent box widths) centred on the edge, while the neighbour's ramps from 0 to 1: a
 // partition of unity whose integral over each face is its box width (so Σ α |V| is still the
-// body's area). Its weight is the box convolved with a box of width ε h: C⁰, so α varies with
-// C¹ smoothness as a body crosses the grid, where the box's α (ε = 0, paper Sec. 3.2.1) has a kink
-// each time an edge of the body meets a box edge. ε = 1 on a uniform grid is the tent of width
-// 2h. Along each direction the line is cut into intervals, flat (one face, weight 1) or ramps
+// body's area). On a uniform grid the weight is the box convolved with a box of width ε h (on a
+// stretched one each edge has its own ramp width). It is C⁰, so α varies with C¹ smoothness as
+// a body crosses the grid, where the box's α (ε = 0, paper Sec. 3.2.1) has a kink each time an
+// edge of the body meets a box edge. ε = 1 on a uniform grid is the tent of width 2h. Along each direction the line is cut into intervals, flat (one face, weight 1) or ramps
 // (two faces, linear weights); `boxes` holds the intervals as boxes (ex, ey their edges) and
 // face[k][e], w0[k][e], w1[k][e] (e = 0, 1) each interval's faces (−1: none) and weights at its
 // two ends.
@@ -130,7 +130,7 @@ class ImmersedSolid {
     std::int32_t face, body;
     std::int32_t node[3];
     double w[3];
-    double area() const { return w[0] + w[1] + w[2]; }  // |P|: the weights sum to it
+    double area() const { return w[0] + w[1] + w[2]; }  // |P| (smoothed: ∫_P φ): the weights' sum
   };
   using Raw = std::vector<Piece>;
   // The rigid fixed bodies' pieces of one family, clipped once, and what never changes about

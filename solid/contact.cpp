@@ -414,16 +414,33 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
       const double l = std::hypot(dx, dy);
       return Vec2{dy / l, -dx / l};
     };
+    const double floor = -std::max(kKeepEdge * reach, m_gap_tol);
     double qx0, qy0;
     Vec2 n0{0, 0};
     const double sx = start[2 * s.slave_node], sy = start[2 * s.slave_node + 1];
     if (vertex) {
+      // At a vertex, as the gap is taken: the signed distance to the nearer of its two edges
+      // (that edge's normal for an interior projection, the pseudo-normal at the vertex).
       const int v = xi <= 0 ? e[0] : e[1];
       for (int j : surf.vertex_edges[v]) {
         const Vec2 nj = normal_at(j);
         n0[0] += nj[0], n0[1] += nj[1];
       }
-      qx0 = sx - start[2 * v], qy0 = sy - start[2 * v + 1];
+      double nearest = std::numeric_limits<double>::max(), g0 = 0;
+      for (int j : surf.vertex_edges[v]) {
+        const auto& ej = mesh.surface[j];
+        const double bx = start[2 * ej[0]], by = start[2 * ej[0] + 1];
+        const double fx = start[2 * ej[1]] - bx, fy = start[2 * ej[1] + 1] - by;
+        const double t = std::clamp(((sx - bx) * fx + (sy - by) * fy) / (fx * fx + fy * fy), 0.0, 1.0);
+        const double rx = sx - bx - t * fx, ry = sy - by - t * fy;
+        const double dj = std::hypot(rx, ry);
+        if (dj >= nearest) continue;
+        nearest = dj;
+        const Vec2 nj = t > 0 && t < 1 ? normal_at(j) : n0;
+        g0 = rx * nj[0] + ry * nj[1] < 0 ? -dj : dj;
+      }
+      if (nearest == std::numeric_limits<double>::max()) return true;  // no edges: no side
+      return g0 >= floor;
     } else {
       const double w = std::clamp(xi, 0.0, 1.0);
       const double ax0 = start[2 * e[0]], ay0 = start[2 * e[0] + 1];
@@ -433,8 +450,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
       qx0 = sx - ax0 - w * dx, qy0 = sy - ay0 - w * dy;
     }
     const double ln = std::hypot(n0[0], n0[1]);
-    if (ln <= 1e-6) return true;  // a vertex folded back onto itself: no side to tell
-    return (qx0 * n0[0] + qy0 * n0[1]) / ln >= -std::max(kKeepEdge * reach, m_gap_tol);
+    return (qx0 * n0[0] + qy0 * n0[1]) / ln >= floor;
   };
   // Nodes whose edges are never passed over as the body's other side.
   const int guard[4] = {front[0], front[1], s.active ? s.m0 : -1, s.active ? s.m1 : -1};

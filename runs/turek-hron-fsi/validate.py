@@ -369,6 +369,7 @@ def jitter(hist, q, window=WINDOW):
     grid-crossing jitter (README, "Force jitter")."""
     t, y = hist[q]
     n = max(1, int(round(0.01 / (t[1] - t[0]))))
+    n += 1 - n % 2  # odd: the average centred on a sample (an even one lags by half a step)
     ys = np.convolve(y, np.ones(n) / n, mode="valid")
     tt, r = t[n // 2:n // 2 + len(ys)], y[n // 2:n // 2 + len(ys)] - ys
     return float(np.sqrt(np.mean(r[tt >= tt[-1] - window] ** 2)))

@@ -450,6 +450,7 @@ TEST_CASE("smoothed footprint: the weights add up to the body's area, for u- and
         CHECK(std::abs(sum_alpha_volume(FaceBoxes::u_faces(c.g), u) - c.area) <= 1e-12 * c.area);
         CHECK(std::abs(sum_alpha_volume(FaceBoxes::v_faces(c.g), v) - c.area) <= 1e-12 * c.area);
         CHECK(std::abs(is.area_u() - c.area) <= 1e-12 * c.area);
+        CHECK(std::abs(is.area_v() - c.area) <= 1e-12 * c.area);
         for (double a : u.alpha) CHECK((a > 0 && a <= 1.0));
         // The weights reach a face further than its box does: more faces take part.
         ImmersedSolid box(c.g, m);
@@ -487,6 +488,80 @@ TEST_CASE("smoothed footprint: alpha at a straight edge is the weight's share be
       }
     }
     CHECK(checked >= 4 * 8);  // two rows of u-faces and two of v-faces meet the edge
+  }
+}
+
+TEST_CASE("smoothed footprint: alpha at a straight edge on a stretched grid and across a seam") {
+  // The weight of face j along y, from its box edges e (FaceBoxes, the box footprint's) alone:
+  // 1 inside, linear ramps of half-width r_k = ε/2 min(adjacent widths) about each edge, so
+  // α_j = [R(y0; e_j, r_j) − R(y0; e_{j+1}, r_{j+1})] / (e_{j+1} − e_j), R the integral of a ramp
+  // from 0 to 1 over [e − r, e + r] up to y0. `wrap`: a periodic direction of length 1.
+  auto expected = [](const std::vector<double>& e, int j, double y0, double eps, bool wrap) {
+    const int n = static_cast<int>(e.size()) - 1;
+    auto width = [&](int k) {  // box k's width, k taken around the period
+      const int m = ((k % n) + n) % n;
+      return e[m + 1] - e[m];
+    };
+    auto edge = [&](int k) {  // edge k, k in [0, n]; around the period: shifted by 1
+      const int m = ((k % n) + n) % n;
+      return e[m] + (k - m) / n;
+    };
+    auto r = [&](int k) {
+      if (!wrap && (k == 0 || k == n)) return 0.0;
+      return 0.5 * eps * std::min(width(k - 1), width(k));
+    };
+    auto R = [](double y, double c, double h) {
+      if (h <= 0) return std::max(0.0, y - c);
+      if (y <= c - h) return 0.0;
+      if (y >= c + h) return y - c;
+      return (y - c + h) * (y - c + h) / (4 * h);
+    };
+    // The edge nearest y0 among the copies of the face's box (a seam: y0 may lie a period away).
+    double best = 0, shift = 0, dist = 1e9;
+    for (double sh : wrap ? std::vector<double>{-1.0, 0.0, 1.0} : std::vector<double>{0.0}) {
+      const double d = std::abs(0.5 * (edge(j) + edge(j + 1)) + sh - y0);
+      if (d < dist) dist = d, shift = sh;
+    }
+    best = (R(y0 - shift, edge(j), r(j)) - R(y0 - shift, edge(j + 1), r(j + 1))) / width(j);
+    return best;
+  };
+  struct Case {
+    const char* name;
+    proto::GridInfo g;
+    double y0, y_bottom;
+    bool wrap;
+  };
+  auto stretched = grid(20, 20, 1.0, 1.0, false, false);
+  for (int j = 0; j <= 20; ++j) stretched.y_face[j] = std::pow(j / 20.0, 1.3);
+  const Case cases[] = {{"stretched", stretched, 0.5531, 0.3, false},
+                        {"periodic seam", grid(20, 20, 1.0, 1.0, false, true), 1.0185, 0.7, true}};
+  for (const auto& c : cases) {
+    SECTION(c.name) {
+      proto::BodyMeshes m;
+      m.bodies.push_back(rectangle(0.6, c.y0 - c.y_bottom, 12, 8, 0.0, {0.5, 0.5 * (c.y0 + c.y_bottom)}));
+      const double eps = 0.7;
+      ImmersedSolid is(c.g, m, eps);
+      proto::FaceSolid u, v;
+      is.update(at_rest(m), u, v);
+      int checked = 0;
+      for (int comp = 0; comp < 2; ++comp) {
+        const auto faces = comp == 0 ? FaceBoxes::u_faces(c.g) : FaceBoxes::v_faces(c.g);
+        const auto& fs = comp == 0 ? u : v;
+        for (std::size_t k = 0; k < fs.index.size(); ++k) {
+          const int i = fs.index[k] % faces.ni, j = fs.index[k] / faces.ni;
+          const double xf = comp == 0 ? c.g.x_face[i] : 0.5 * (c.g.x_face[i] + c.g.x_face[i + 1]);
+          if (xf < 0.3 || xf > 0.7) continue;  // whole along x: its x weight integrates to 1
+          const double centre = 0.5 * (faces.ey[j] + faces.ey[j + 1]);
+          double off = centre - c.y0;  // from the top edge (around the period when periodic)
+          if (c.wrap) off -= std::round(off);
+          if (std::abs(off) > 0.15) continue;
+          INFO("face " << comp << " (" << i << ", " << j << ")");
+          CHECK(std::abs(fs.alpha[k] - expected(faces.ey, j, c.y0, eps, c.wrap)) <= 1e-12);
+          ++checked;
+        }
+      }
+      CHECK(checked >= 4 * 8);
+    }
   }
 }
 
