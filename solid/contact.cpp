@@ -384,19 +384,41 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     const auto& e = mesh.surface[k];
     return std::hypot(x[2 * e[1]] - x[2 * e[0]], x[2 * e[1] + 1] - x[2 * e[0] + 1]);
   };
-  auto edge_normal = [&](int k) {
+  // Edge k's unit normal (the body on its left) at positions `pos`.
+  auto normal_at = [&](const std::vector<double>& pos, int k) {
     const auto& e = mesh.surface[k];
-    const double l = edge_length(k);
-    return Vec2{(x[2 * e[1] + 1] - x[2 * e[0] + 1]) / l, -(x[2 * e[1]] - x[2 * e[0]]) / l};
+    const double dx = pos[2 * e[1]] - pos[2 * e[0]], dy = pos[2 * e[1] + 1] - pos[2 * e[0] + 1];
+    const double l = std::hypot(dx, dy);
+    return Vec2{dy / l, -dx / l};
   };
-  // The sum of the normals of the edges at vertex v (not normalised).
-  auto pseudo_normal = [&](int v) {
+  // The sum of the normals of the edges at vertex v (not normalised), at positions `pos`.
+  auto pseudo_normal_at = [&](const std::vector<double>& pos, int v) {
     Vec2 nv{0, 0};
     for (int j : surf.vertex_edges[v]) {
-      const Vec2 nj = edge_normal(j);
+      const Vec2 nj = normal_at(pos, j);
       nv[0] += nj[0], nv[1] += nj[1];
     }
     return nv;
+  };
+  auto pseudo_normal = [&](int v) { return pseudo_normal_at(x, v); };
+  // The signed distance from (qx, qy) to the nearer of vertex v's edges at positions `pos`: its
+  // sign from that edge's normal for a projection inside it, from n_v (v's pseudo-normal there)
+  // at v itself. 0 for a vertex without edges.
+  auto vertex_gap = [&](const std::vector<double>& pos, int v, double qx, double qy, const Vec2& n_v) {
+    double nearest = std::numeric_limits<double>::max(), g = 0;
+    for (int j : surf.vertex_edges[v]) {
+      const auto& ej = mesh.surface[j];
+      const double bx = pos[2 * ej[0]], by = pos[2 * ej[0] + 1];
+      const double fx = pos[2 * ej[1]] - bx, fy = pos[2 * ej[1] + 1] - by;
+      const double t = std::clamp(((qx - bx) * fx + (qy - by) * fy) / (fx * fx + fy * fy), 0.0, 1.0);
+      const double rx = qx - bx - t * fx, ry = qy - by - t * fy;
+      const double dj = std::hypot(rx, ry);
+      if (dj >= nearest) continue;
+      nearest = dj;
+      const Vec2 nj = t > 0 && t < 1 ? normal_at(pos, j) : n_v;
+      g = rx * nj[0] + ry * nj[1] < 0 ? -dj : dj;
+    }
+    return g;
   };
   // Whether the node was in front of (or on) the feature at the step's start (`start`, the
   // body's positions then; none given: yes): the feature's point under it then (the vertex, or
@@ -408,49 +430,17 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
   auto in_front_at_start = [&](const std::array<int, 2>& e, double xi, bool vertex,
                                const std::vector<double>& start) {
     if (start.empty()) return true;
-    auto normal_at = [&](int k) {
-      const auto& ek = mesh.surface[k];
-      const double dx = start[2 * ek[1]] - start[2 * ek[0]], dy = start[2 * ek[1] + 1] - start[2 * ek[0] + 1];
-      const double l = std::hypot(dx, dy);
-      return Vec2{dy / l, -dx / l};
-    };
     const double floor = -std::max(kKeepEdge * reach, m_gap_tol);
-    double qx0, qy0;
-    Vec2 n0{0, 0};
     const double sx = start[2 * s.slave_node], sy = start[2 * s.slave_node + 1];
-    if (vertex) {
-      // At a vertex, as the gap is taken: the signed distance to the nearer of its two edges
-      // (that edge's normal for an interior projection, the pseudo-normal at the vertex).
+    if (vertex) {  // as the gap is taken at a vertex: to the nearer of its two edges
       const int v = xi <= 0 ? e[0] : e[1];
-      for (int j : surf.vertex_edges[v]) {
-        const Vec2 nj = normal_at(j);
-        n0[0] += nj[0], n0[1] += nj[1];
-      }
-      double nearest = std::numeric_limits<double>::max(), g0 = 0;
-      for (int j : surf.vertex_edges[v]) {
-        const auto& ej = mesh.surface[j];
-        const double bx = start[2 * ej[0]], by = start[2 * ej[0] + 1];
-        const double fx = start[2 * ej[1]] - bx, fy = start[2 * ej[1] + 1] - by;
-        const double t = std::clamp(((sx - bx) * fx + (sy - by) * fy) / (fx * fx + fy * fy), 0.0, 1.0);
-        const double rx = sx - bx - t * fx, ry = sy - by - t * fy;
-        const double dj = std::hypot(rx, ry);
-        if (dj >= nearest) continue;
-        nearest = dj;
-        const Vec2 nj = t > 0 && t < 1 ? normal_at(j) : n0;
-        g0 = rx * nj[0] + ry * nj[1] < 0 ? -dj : dj;
-      }
-      if (nearest == std::numeric_limits<double>::max()) return true;  // no edges: no side
-      return g0 >= floor;
-    } else {
-      const double w = std::clamp(xi, 0.0, 1.0);
-      const double ax0 = start[2 * e[0]], ay0 = start[2 * e[0] + 1];
-      const double dx = start[2 * e[1]] - ax0, dy = start[2 * e[1] + 1] - ay0;
-      const double l = std::hypot(dx, dy);
-      n0 = {dy / l, -dx / l};
-      qx0 = sx - ax0 - w * dx, qy0 = sy - ay0 - w * dy;
+      return vertex_gap(start, v, sx, sy, pseudo_normal_at(start, v)) >= floor;
     }
-    const double ln = std::hypot(n0[0], n0[1]);
-    return (qx0 * n0[0] + qy0 * n0[1]) / ln >= floor;
+    const double w = std::clamp(xi, 0.0, 1.0);
+    const double ax0 = start[2 * e[0]], ay0 = start[2 * e[0] + 1];
+    const double dx = start[2 * e[1]] - ax0, dy = start[2 * e[1] + 1] - ay0;
+    const double l = std::hypot(dx, dy);
+    return ((sx - ax0 - w * dx) * dy - (sy - ay0 - w * dy) * dx) / l >= floor;
   };
   // Nodes whose edges are never passed over as the body's other side.
   const int guard[4] = {front[0], front[1], s.active ? s.m0 : -1, s.active ? s.m1 : -1};
@@ -529,20 +519,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     const bool in_zone = zone >= 0 && ln > 1e-6;
     if (in_zone) {  // (a vertex whose edges fold back onto each other has no pseudo-normal)
       n = {nv[0] / ln, nv[1] / ln};
-      double nearest = std::numeric_limits<double>::max();
-      for (int j : surf.vertex_edges[zone]) {
-        const auto& ej = mesh.surface[j];
-        const double bx = x[2 * ej[0]], by = x[2 * ej[0] + 1];
-        const double fx = x[2 * ej[1]] - bx, fy = x[2 * ej[1] + 1] - by;
-        const double t =
-            std::clamp(((px - bx) * fx + (py - by) * fy) / (fx * fx + fy * fy), 0.0, 1.0);
-        const double rx = px - bx - t * fx, ry = py - by - t * fy;
-        const double dj = std::hypot(rx, ry);
-        if (dj >= nearest) continue;
-        nearest = dj;
-        const Vec2 nj = t > 0 && t < 1 ? edge_normal(j) : n;
-        g = rx * nj[0] + ry * nj[1] < 0 ? -dj : dj;
-      }
+      g = vertex_gap(x, zone, px, py, n);
       vertex = true;
       xi = zone == e[0] ? 0 : 1;
     } else if (vertex) {

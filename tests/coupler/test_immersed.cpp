@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
+#include <string>
 
 #include "clip.hpp"
 #include "fixtures.hpp"
@@ -170,14 +171,17 @@ TEST_CASE("triangle-box clipping") {
   SECTION("disjoint") { CHECK(clip_triangle_box(t, 2, 3, 2, 3, out) == 0); }
 }
 
-TEST_CASE("volume fractions add up to the body's area, for u- and v-cells separately") {
-  struct Case {
-    const char* name;
-    proto::GridInfo g;
-    proto::BodyMesh body;
-    double area;
-  };
-  std::vector<Case> cases;
+namespace {
+
+// Bodies on grids whose footprints must add up to the body's area.
+struct AreaCase {
+  std::string name;
+  proto::GridInfo g;
+  proto::BodyMesh body;
+  double area;
+};
+std::vector<AreaCase> area_cases() {
+  std::vector<AreaCase> cases;
   cases.push_back({"rotated square", grid(32, 24, 1.0, 0.75, false, false),
                    rectangle(0.3, 0.3, 7, 7, 0.37, {0.47, 0.39}), 0.09});
   double disk_area = 0;
@@ -193,7 +197,13 @@ TEST_CASE("volume fractions add up to the body's area, for u- and v-cells separa
                      return g;
                    }(),
                    rectangle(0.5, 0.3, 10, 6, -0.6, {0.5, 0.5}), 0.15});
-  for (auto& c : cases) {
+  return cases;
+}
+
+}  // namespace
+
+TEST_CASE("volume fractions add up to the body's area, for u- and v-cells separately") {
+  for (auto& c : area_cases()) {
     SECTION(c.name) {
       proto::BodyMeshes m;
       m.bodies.push_back(c.body);
@@ -417,31 +427,10 @@ double smoothed_below(double d, double e) {
 }  // namespace
 
 TEST_CASE("smoothed footprint: the weights add up to the body's area, for u- and v-faces") {
-  struct Case {
-    const char* name;
-    proto::GridInfo g;
-    proto::BodyMesh body;
-    double area;
-  };
-  std::vector<Case> cases;
-  cases.push_back({"rotated square", grid(32, 24, 1.0, 0.75, false, false),
-                   rectangle(0.3, 0.3, 7, 7, 0.37, {0.47, 0.39}), 0.09});
-  double disk_area = 0;
-  auto d = disk(0.17, 6, {0.52, 0.4}, &disk_area);
-  cases.push_back({"disk", grid(40, 32, 1.0, 0.8, false, false), d, disk_area});
-  cases.push_back({"across the periodic boundaries", grid(32, 32, 1.0, 1.0, true, true),
-                   rectangle(0.4, 0.25, 9, 5, 0.2, {0.97, 0.02}), 0.1});
-  cases.push_back({"travelled several periods", grid(32, 32, 1.0, 1.0, true, true),
-                   rectangle(0.4, 0.25, 9, 5, 0.2, {0.97 + 2.0, 0.02 - 3.0}), 0.1});
-  cases.push_back({"stretched grid", [] {
-                     auto g = grid(30, 20, 1.0, 1.0, true, false);
-                     for (int j = 0; j <= 20; ++j) g.y_face[j] = std::pow(j / 20.0, 1.5);
-                     return g;
-                   }(),
-                   rectangle(0.5, 0.3, 10, 6, -0.6, {0.5, 0.5}), 0.15});
+  const auto cases = area_cases();
   for (const double eps : {0.5, 1.0}) {
     for (auto& c : cases) {
-      SECTION(c.name + std::string(eps == 1.0 ? ", eps 1" : ", eps 0.5")) {
+      SECTION(c.name + (eps == 1.0 ? ", eps 1" : ", eps 0.5")) {
         proto::BodyMeshes m;
         m.bodies.push_back(c.body);
         ImmersedSolid is(c.g, m, eps);
