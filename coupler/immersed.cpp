@@ -109,7 +109,6 @@ SmoothBoxes SmoothBoxes::of(const FaceBoxes& faces, double smoothing) {
 ImmersedSolid::Family::Family(const FaceBoxes& f, double smoothing)
     : faces(f),
       smooth(smoothing > 0 ? SmoothBoxes::of(f, smoothing) : SmoothBoxes{}),
-      smoothed(smoothing > 0),
       ix(clip_boxes().ex),
       iy(clip_boxes().ey) {}
 
@@ -155,7 +154,7 @@ void ImmersedSolid::clip_body(const Family& fam, int b, const std::vector<double
   const FaceBoxes& faces = fam.faces;
   const EdgeIndex& ix = fam.ix;
   const EdgeIndex& iy = fam.iy;
-  const bool smoothed = fam.smoothed;
+  const bool smoothed = fam.smoothed();
   const SmoothBoxes::Axis& sax = fam.smooth.ax;
   const SmoothBoxes::Axis& say = fam.smooth.ay;
   const auto& tri = m_meshes.bodies[b].tri;

@@ -158,13 +158,13 @@ class ImmersedSolid {
   // One family's clipping: its face boxes, or smoothed its interval boxes.
   struct Family {
     FaceBoxes faces;      // the faces and their control volumes
-    SmoothBoxes smooth;   // the smoothed footprint's intervals (unused when ε = 0)
-    bool smoothed;
+    SmoothBoxes smooth;   // the smoothed footprint's intervals (none when ε = 0)
     EdgeIndex ix, iy;     // box lookup of the boxes clipped against
     Family(const FaceBoxes& f, double smoothing);
     Family(const Family&) = delete;  // ix, iy point into this family's edges
     Family& operator=(const Family&) = delete;
-    const FaceBoxes& clip_boxes() const { return smoothed ? smooth.boxes : faces; }
+    bool smoothed() const { return !smooth.ax.face.empty(); }
+    const FaceBoxes& clip_boxes() const { return smoothed() ? smooth.boxes : faces; }
   };
   void clip_body(const Family& fam, int b, const std::vector<double>& x, Raw& raw) const;
   struct Scratch {  // per face of a family: -1, or its slot while gather() or index_fixed() runs

@@ -244,14 +244,7 @@ def fsi2(metrics, rows):
         folder, wall, _ = run(f"fsi2-{level}", scene_text("fsi2", level))
         hist = histories(folder)
         res = {q: analyse(*hist[q]) for q in hist}
-        # The forces carry a jitter from faces whose volume fraction changes as the bar crosses
-        # the grid (spikes of a few steps, visible in fsi2_histories.png); a 10 ms moving average
-        # removes it and damps the 3.9 Hz drag fundamental by a factor sin(x)/x = 0.998 only.
-        for q in ("drag", "lift"):
-            t, y = hist[q]
-            n = max(1, int(round(0.01 / (t[1] - t[0]))))
-            ys = np.convolve(y, np.ones(n) / n, mode="valid")
-            res[q + "_smoothed"] = analyse(t[n // 2:n // 2 + len(ys)], ys)
+        add_smoothed(hist, res)
         steps = outputs.summary(folder)["steps"]
         row = {"level": level, "cells": [int(round(L * lv["n"] / H)), lv["n"]], "dt": lv["dt"],
                "bar_cells": lv["bar"], "steps": steps, "wall_s": wall, "results": res,
@@ -364,14 +357,31 @@ def dt_limit():
         json.dump(rows, f, indent=2)
 
 
+def moving_average(t, y, odd=False):
+    """The 10 ms moving average of y: (its times, the average, y at those times). `odd`: an odd
+    number of samples, the average centred on a sample (an even one lags by half a step)."""
+    n = max(1, int(round(0.01 / (t[1] - t[0]))))
+    if odd:
+        n += 1 - n % 2
+    ys = np.convolve(y, np.ones(n) / n, mode="valid")
+    return t[n // 2:n // 2 + len(ys)], ys, y[n // 2:n // 2 + len(ys)]
+
+
+def add_smoothed(hist, res):
+    """res[drag_smoothed], res[lift_smoothed]: the forces' mean and amplitude after the 10 ms
+    moving average. The forces carry a jitter from the bar crossing the grid (README, "Force
+    jitter"); the average removes it and damps the 3.9 Hz drag fundamental by a factor
+    sin(x)/x = 0.998 only."""
+    for q in ("drag", "lift"):
+        tt, ys, _ = moving_average(*hist[q])
+        res[q + "_smoothed"] = analyse(tt, ys)
+
+
 def jitter(hist, q, window=WINDOW):
     """The rms over the last `window` seconds of the force minus its 10 ms moving average: the
     grid-crossing jitter (README, "Force jitter")."""
-    t, y = hist[q]
-    n = max(1, int(round(0.01 / (t[1] - t[0]))))
-    n += 1 - n % 2  # odd: the average centred on a sample (an even one lags by half a step)
-    ys = np.convolve(y, np.ones(n) / n, mode="valid")
-    tt, r = t[n // 2:n // 2 + len(ys)], y[n // 2:n // 2 + len(ys)] - ys
+    tt, ys, yc = moving_average(*hist[q], odd=True)
+    r = yc - ys
     return float(np.sqrt(np.mean(r[tt >= tt[-1] - window] ** 2)))
 
 
@@ -387,11 +397,7 @@ def smoothing_study():
         res = {q: analyse(*hist[q]) for q in hist}
         r = {"smoothing": eps, "wall_s": wall, "results": res,
              "jitter_rms": {q: jitter(hist, q) for q in ("drag", "lift")}, "errors": {}}
-        for q in ("drag", "lift"):
-            t, y = hist[q]
-            n = max(1, int(round(0.01 / (t[1] - t[0]))))
-            ys = np.convolve(y, np.ones(n) / n, mode="valid")
-            res[q + "_smoothed"] = analyse(t[n // 2:n // 2 + len(ys)], ys)
+        add_smoothed(hist, res)
         for _, q, _ in QUANTITIES:
             ref = REF[("fsi2", q)]
             r["errors"][q] = {"mean": rel(res[q]["mean"], ref["mean"]),
