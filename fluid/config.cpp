@@ -318,6 +318,8 @@ Config read_config(const fsi::SceneTable& f, double dt) {
   }
   // Only when given: a scene without it keeps its effective scene as it was.
   if (f.has("upwind_blend")) c.upwind_blend = f.in_range("upwind_blend", 0.0, 1.0, false, 0.0);
+  if (f.has("convection"))
+    c.upwind3 = f.choice("convection", {"central", "upwind3"}, "central") == "upwind3";
   // The launcher's: how many ranks ./fsi gives the fluid (the job's own count decides).
   if (f.has("ranks")) c.ranks = int(f.positive_integer("ranks"));
 

@@ -94,6 +94,9 @@ struct Config {
   double forcing_time = -1;
   // Weight of first-order upwind in the convective fluxes outside the sponge (0: central).
   double upwind_blend = 0;
+  // fluid.convection = "upwind3": third-order upwind-biased carried values outside the sponge
+  // (momentum.hpp, upwind3_terms); "central" (the default): the two-point average.
+  bool upwind3 = false;
   int ranks = 0;  // [fluid] ranks: the ranks ./fsi launches the fluid on (0: not given)
   // Body force per unit volume f(t) = body + oscillating sin(2 pi t / period + phase) (Eq. 29
   // with body = 0), plus rho g.

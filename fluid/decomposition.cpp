@@ -50,6 +50,26 @@ void Decomposition::halo(Field& f) const {
   m_traffic.halo_bytes += 8.0 * n * ((down != MPI_PROC_NULL) + (up != MPI_PROC_NULL));
 }
 
+void Decomposition::outer_rows(const Field& f, OuterRows& o) const {
+  if (m_ranks == 1) return;
+  const bool first = m_rank == 0, last = m_rank == m_ranks - 1;
+  const int down = first ? (m_periodic ? m_ranks - 1 : MPI_PROC_NULL) : m_rank - 1;
+  const int up = last ? (m_periodic ? 0 : MPI_PROC_NULL) : m_rank + 1;
+  const int n = f.sx;
+  o.below.resize(n);
+  o.above.resize(n);
+  const double t0 = MPI_Wtime();
+  // Row lo + 1 down (the lower neighbour's hi + 1), row hi - 2 up (the upper one's lo - 2); a
+  // slab has at least two rows.
+  MPI_Sendrecv(f.row(m_lo + 1) - 1, n, MPI_DOUBLE, down, 7303, o.above.data(), n, MPI_DOUBLE, up,
+               7303, m_comm, MPI_STATUS_IGNORE);
+  MPI_Sendrecv(f.row(m_hi - 2) - 1, n, MPI_DOUBLE, up, 7304, o.below.data(), n, MPI_DOUBLE, down,
+               7304, m_comm, MPI_STATUS_IGNORE);
+  m_traffic.halo_seconds += MPI_Wtime() - t0;
+  ++m_traffic.halos;
+  m_traffic.halo_bytes += 8.0 * n * ((down != MPI_PROC_NULL) + (up != MPI_PROC_NULL));
+}
+
 // Times a collective into the traffic counters.
 template <class F>
 void Decomposition::collective(F&& f) const {

@@ -48,6 +48,9 @@ class Decomposition {
   // The ghost rows lo - 1 and hi of f from the neighbours (the whole stored rows, ghost columns
   // included). Collective.
   void halo(Field& f) const;
+  // The second rows beyond the slab, lo - 2 and hi + 1, of f into o (the whole stored rows;
+  // those beyond a non-periodic end left as they are). Collective; nothing on one rank.
+  void outer_rows(const Field& f, OuterRows& o) const;
   // Sums and maxima over the ranks (collective; on one rank the value itself).
   double sum(double x) const;
   void sum(double* x, int n) const;

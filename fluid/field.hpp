@@ -38,4 +38,10 @@ struct Field {
   const double* row(int j) const { return a.data() + 1 + std::size_t(sx) * (j - jlo + 1); }
 };
 
+// The second row beyond each edge of a slab (rows lo - 2 and hi + 1, ghost columns included),
+// which the third-order convection reads across the slab's edges; empty on one rank.
+struct OuterRows {
+  std::vector<double> below, above;
+};
+
 }  // namespace fluid

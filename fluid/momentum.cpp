@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "error.hpp"
+
 namespace fluid {
 
 SpongeWeights sponge_weights(const Grid& g, double blend) {
@@ -135,6 +137,126 @@ void momentum_terms(const Grid& g, const SpongeWeights& sw, const Field& u, cons
   } else {
     lap ? kernel<false, true>(g, sw, u, v, nu_e, i0, j0, hu, hv, lu, lv)
         : kernel<false, false>(g, sw, u, v, nu_e, i0, j0, hu, hv, lu, lv);
+  }
+}
+
+namespace {
+
+// q3 - (l + r)/2 for the carried value across the face between l and r, carried by a (the
+// header's formula).
+inline double third_order(double a, double m, double l, double r, double p) {
+  const double s = a > 0 ? 1.0 : a < 0 ? -1.0 : 0.0;
+  return ((l + r - m - p) + s * (p - 3.0 * r + 3.0 * l - m)) * (1.0 / 12.0);
+}
+
+// Stored index of position k along a direction of n periodic cells whose field stores
+// [-1, last]: beyond it, the position one period in.
+inline int wrap(int k, int n, int last, bool periodic) {
+  if (!periodic) return k;
+  return k < -1 ? k + n : k > last ? k - n : k;
+}
+
+}  // namespace
+
+void upwind3_terms(const Grid& g, const SpongeWeights& sw, const Field& u, const Field& v,
+                   const OuterRows& ou, const OuterRows& ov, int i0, int j0, Field& hu, Field& hv) {
+  const int nx = g.nx(), ny = g.ny();
+  const bool px = g.x().periodic(), py = g.y().periodic();
+  const Axis& X = g.x();
+  const Axis& Y = g.y();
+  const double *xwi = X.wi(), *xdi = X.di(), *xlo = X.wlo(), *xhi = X.whi();
+  const double *ywi = Y.wi(), *ydi = Y.di(), *ylo = Y.wlo(), *yhi = Y.whi();
+  const double* bc = sw.centre.data() + 1;
+  const double* bf = sw.face.data() + 1;
+  // Row j of f: stored, wrapped (periodic y on one rank) or an outer row (several ranks).
+  // The rows filled on every rank are [lo - 1, hi] (hi = u's last stored row; v's top rank
+  // stores one more, which a periodic y leaves unfilled there).
+  const int hi = u.jhi;
+  auto row = [&](const Field& f, const OuterRows& o, int j) -> const double* {
+    if (j >= f.jlo - 1 && j <= hi) return f.row(j);
+    if (o.below.empty()) return f.row(wrap(j, ny, hi, py));
+    FSI_ASSERT(j == f.jlo - 2 || j == hi + 1);
+    return (j < f.jlo ? o.below.data() : o.above.data()) + 1;
+  };
+  // Whether a four-value stencil [k - 1, k + 2] lies in [0, last] (always when periodic).
+  auto inside = [](int k, int last, bool periodic) {
+    return periodic || (k >= 1 && k + 2 <= last);
+  };
+  std::vector<double> f(nx + 2), gs(nx + 1), gn(nx + 1);
+
+  // u faces: x fluxes at cells c (between faces c and c + 1), y fluxes at corners (face i, row
+  // boundary j between rows j - 1 and j).
+  const int ju0 = hu.jlo, ju1 = hu.jhi;
+  auto u_corner = [&](int j, std::vector<double>& out) {
+    const bool ok = inside(j - 1, ny - 1, py);
+    const double* r[4] = {nullptr, nullptr, nullptr, nullptr};
+    if (ok)
+      for (int k = 0; k < 4; ++k) r[k] = row(u, ou, j - 2 + k);
+    const double* vr = v.row(j);
+    for (int i = i0; i < nx; ++i) {
+      if (!ok) {
+        out[i] = 0;
+        continue;
+      }
+      const double a = xlo[i] * vr[i - 1] + xhi[i] * vr[i];
+      out[i] = (1.0 - bf[i]) * a * third_order(a, r[0][i], r[1][i], r[2][i], r[3][i]);
+    }
+  };
+  if (ju0 < ju1) u_corner(ju0, gs);
+  for (int j = ju0; j < ju1; ++j) {
+    const double* uc = u.row(j);
+    for (int c = i0 - 1; c < nx; ++c) {
+      if (!inside(c, nx, px)) {
+        f[c + 1] = 0;
+        continue;
+      }
+      const double a = 0.5 * (uc[c] + uc[c + 1]);
+      const double m = uc[wrap(c - 1, nx, nx + 1, px)], p = uc[wrap(c + 2, nx, nx + 1, px)];
+      f[c + 1] = (1.0 - bc[c]) * a * third_order(a, m, uc[c], uc[c + 1], p);
+    }
+    u_corner(j + 1, gn);
+    double* h = hu.row(j);
+    const double ywij = ywi[j];
+    for (int i = i0; i < nx; ++i) h[i] -= (f[i + 1] - f[i]) * xdi[i] + (gn[i] - gs[i]) * ywij;
+    std::swap(gs, gn);
+  }
+
+  // v faces: y fluxes at cells c (between faces c and c + 1), x fluxes at corners (column
+  // boundary i between cells i - 1 and i, face row j).
+  const int jv0 = std::max(j0, hv.jlo), jv1 = std::min(ny, hv.jhi);
+  auto v_cells = [&](int c, std::vector<double>& out) {
+    const bool ok = inside(c, ny, py);
+    const double* r[4] = {nullptr, nullptr, nullptr, nullptr};
+    if (ok)
+      for (int k = 0; k < 4; ++k) r[k] = row(v, ov, c - 1 + k);
+    for (int i = 0; i < nx; ++i) {
+      if (!ok) {
+        out[i] = 0;
+        continue;
+      }
+      const double a = 0.5 * (r[1][i] + r[2][i]);
+      out[i] = (1.0 - bc[i]) * a * third_order(a, r[0][i], r[1][i], r[2][i], r[3][i]);
+    }
+  };
+  if (jv0 < jv1) v_cells(jv0 - 1, gs);
+  for (int j = jv0; j < jv1; ++j) {
+    const double* vc = v.row(j);
+    const double* uc = u.row(j);
+    const double* us = u.row(j - 1);
+    for (int i = 0; i <= nx; ++i) {
+      if (!inside(i - 1, nx - 1, px)) {
+        f[i] = 0;
+        continue;
+      }
+      const double a = ylo[j] * us[i] + yhi[j] * uc[i];
+      const double m = vc[wrap(i - 2, nx, nx, px)], p = vc[wrap(i + 1, nx, nx, px)];
+      f[i] = (1.0 - bf[i]) * a * third_order(a, m, vc[i - 1], vc[i], p);
+    }
+    v_cells(j, gn);
+    double* h = hv.row(j);
+    const double ydj = ydi[j];
+    for (int i = 0; i < nx; ++i) h[i] -= (f[i + 1] - f[i]) * xwi[i] + (gn[i] - gs[i]) * ydj;
+    std::swap(gs, gn);
   }
 }
 

@@ -1,5 +1,6 @@
 // Explicit momentum terms on the MAC grid: convection in divergence form with 2nd-order
-// central fluxes (first-order upwind fluxes inside the outlet sponge) and viscous diffusion.
+// central fluxes or third-order upwind-biased carried values (first-order upwind fluxes inside
+// the outlet sponge) and viscous diffusion.
 #pragma once
 
 #include <vector>
@@ -24,5 +25,19 @@ SpongeWeights sponge_weights(const Grid& g, double blend = 0.0);
 // explicit diffusion and 0 for implicit. Ghosts of u and v must be filled.
 void momentum_terms(const Grid& g, const SpongeWeights& sw, const Field& u, const Field& v,
                     double nu_e, int i0, int j0, Field& hu, Field& hv, Field* lu, Field* lv);
+
+// The third-order upwind correction (fluid.convection = "upwind3"), added to the terms of
+// momentum_terms over the same faces. Each flux's carried value q becomes
+//   q + (1 - beta) [ q3 - (q_l + q_r)/2 ],   q3 = (-q_m + 7 q_l + 7 q_r - q_p)/12
+//                                                  + sgn(a) (q_p - 3 q_r + 3 q_l - q_m)/12
+// (m, l, r, p the four values along the flux's direction, l and r beside the face; for a > 0
+// q3 = (-q_m + 5 q_l + 2 q_r)/6, Leonard's third-order upwind-biased interpolation), with beta
+// the sponge weight (1 inside: first-order upwind stays there; the blend outside). The correction
+// is a second and a third difference added to the two-point value, with these coefficients on
+// stretched cells too (consistent there, of lower order). Where the four values do not exist (the
+// faces next to a non-periodic side) the flux keeps its two-point value. Ghosts of u and v must
+// be filled; on several ranks ou, ov hold the outer rows.
+void upwind3_terms(const Grid& g, const SpongeWeights& sw, const Field& u, const Field& v,
+                   const OuterRows& ou, const OuterRows& ov, int i0, int j0, Field& hu, Field& hv);
 
 }  // namespace fluid

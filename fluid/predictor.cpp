@@ -12,6 +12,11 @@ void Solver::explicit_terms() {
   const bool imp = m_cfg.implicit;
   momentum_terms(m_grid, m_sponge, m_u, m_v, imp ? 0.0 : m_nu, m_i0, m_j0, m_hu, m_hv,
                  imp ? &m_lu : nullptr, imp ? &m_lv : nullptr);
+  if (m_cfg.upwind3) {
+    m_dec.outer_rows(m_u, m_outer_u);
+    m_dec.outer_rows(m_v, m_outer_v);
+    upwind3_terms(m_grid, m_sponge, m_u, m_v, m_outer_u, m_outer_v, m_i0, m_j0, m_hu, m_hv);
+  }
 }
 
 // Explicit predictor (AB2 for convection and diffusion, Euler on the first step):

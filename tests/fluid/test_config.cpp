@@ -113,6 +113,18 @@ TEST_CASE("upwind_blend: read, and refused outside [0, 1]", "[fluid][config][upw
                     Contains("upwind_blend") && Contains("1.5"));
 }
 
+TEST_CASE("convection: central by default, upwind3, anything else refused",
+          "[fluid][config][upwind]") {
+  auto with = [](const std::string& keys) {
+    return replace(kGood, "viscosity = 0.01", "viscosity = 0.01\n" + keys);
+  };
+  CHECK_FALSE(read(kGood).upwind3);
+  CHECK_FALSE(read(with("convection = \"central\"")).upwind3);
+  CHECK(read(with("convection = \"upwind3\"")).upwind3);
+  CHECK_THROWS_WITH(read(with("convection = \"quick\"")),
+                    Contains("convection") && Contains("quick") && Contains("upwind3"));
+}
+
 TEST_CASE("forcing_time: read, refused negative or with the increment forcing",
           "[fluid][config]") {
   auto with = [](const std::string& keys) {

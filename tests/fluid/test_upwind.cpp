@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "momentum.hpp"
+#include "solver.hpp"
 
 using namespace fluid;
 
@@ -69,4 +71,190 @@ TEST_CASE("upwind blend: linear in the weight, fully upwind at 1", "[fluid][upwi
       errv = std::max(errv, std::abs(v1(i, j) - (-(fx / hx + fy / hy))));
     }
   CHECK(errv < 1e-12);
+}
+
+// fluid.convection = "upwind3": on a doubly periodic grid every flux carries Leonard's
+// third-order upwind-biased value, written out here in its own form: for a > 0 across the face
+// between l and r (m before l, p after r) (-m + 5 l + 2 r)/6, for a < 0 (2 l + 5 r - p)/6.
+TEST_CASE("upwind3: third-order upwind-biased fluxes on a periodic grid", "[fluid][upwind]") {
+  const int nx = 10, ny = 7;
+  AxisSpec ax{nx, 1.0, 0.0}, ay{ny, 0.7, 0.0};
+  ax.periodic = ay.periodic = true;
+  const Grid g(ax, ay);
+  const double hx = 1.0 / nx, hy = 0.7 / ny;
+  // Periodic values, ghosts included (what fill_ghosts leaves).
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> d(-1, 1);
+  std::vector<double> uv(nx * ny), vv(nx * ny);
+  for (double& x : uv) x = d(rng);
+  for (double& x : vv) x = d(rng);
+  auto mod = [](int k, int n) { return ((k % n) + n) % n; };
+  auto U = [&](int i, int j) { return uv[mod(i, nx) + nx * mod(j, ny)]; };
+  auto V = [&](int i, int j) { return vv[mod(i, nx) + nx * mod(j, ny)]; };
+  Field u(nx + 1, ny), v(nx, ny + 1);
+  for (int j = -1; j <= ny; ++j)
+    for (int i = -1; i <= nx + 1; ++i) u(i, j) = U(i, j);
+  for (int j = -1; j <= ny + 1; ++j)
+    for (int i = -1; i <= nx; ++i) v(i, j) = V(i, j);
+  Field hu(nx + 1, ny), hv(nx, ny + 1);
+  const SpongeWeights sw = sponge_weights(g, 0.0);
+  momentum_terms(g, sw, u, v, 0.0, 0, 0, hu, hv, nullptr, nullptr);
+  upwind3_terms(g, sw, u, v, OuterRows{}, OuterRows{}, 0, 0, hu, hv);
+  auto q3 = [](double a, double m, double l, double r, double p) {
+    return a > 0 ? (-m + 5 * l + 2 * r) / 6 : (2 * l + 5 * r - p) / 6;
+  };
+  double err = 0, errv = 0, scale = 0;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      // u face (i, j): x fluxes at the cells i - 1 and i, y fluxes at the corners j and j + 1.
+      const double ue = 0.5 * (U(i, j) + U(i + 1, j)), uw = 0.5 * (U(i - 1, j) + U(i, j));
+      const double fx = ue * q3(ue, U(i - 1, j), U(i, j), U(i + 1, j), U(i + 2, j)) -
+                        uw * q3(uw, U(i - 2, j), U(i - 1, j), U(i, j), U(i + 1, j));
+      const double vn = 0.5 * (V(i - 1, j + 1) + V(i, j + 1)), vs = 0.5 * (V(i - 1, j) + V(i, j));
+      const double fy = vn * q3(vn, U(i, j - 1), U(i, j), U(i, j + 1), U(i, j + 2)) -
+                        vs * q3(vs, U(i, j - 2), U(i, j - 1), U(i, j), U(i, j + 1));
+      err = std::max(err, std::abs(hu(i, j) + fx / hx + fy / hy));
+      scale = std::max(scale, std::abs(hu(i, j)));
+      // v face (i, j): x fluxes at the corners i and i + 1, y fluxes at the cells j - 1 and j.
+      const double ve = 0.5 * (U(i + 1, j - 1) + U(i + 1, j)), vw = 0.5 * (U(i, j - 1) + U(i, j));
+      const double gx = ve * q3(ve, V(i - 1, j), V(i, j), V(i + 1, j), V(i + 2, j)) -
+                        vw * q3(vw, V(i - 2, j), V(i - 1, j), V(i, j), V(i + 1, j));
+      const double vnn = 0.5 * (V(i, j) + V(i, j + 1)), vss = 0.5 * (V(i, j - 1) + V(i, j));
+      const double gy = vnn * q3(vnn, V(i, j - 1), V(i, j), V(i, j + 1), V(i, j + 2)) -
+                        vss * q3(vss, V(i, j - 2), V(i, j - 1), V(i, j), V(i, j + 1));
+      errv = std::max(errv, std::abs(hv(i, j) + gx / hx + gy / hy));
+    }
+  INFO("largest term " << scale);
+  CHECK(scale > 1);
+  CHECK(err < 1e-12 * scale);
+  CHECK(errv < 1e-12 * scale);
+}
+
+// On a bounded grid with a sponge: the carried value is (1 - beta) q3 + beta q_up, so the terms
+// are (1 - b) T3 + b T1 outside the sponge (T3 the upwind3 terms at b = 0, T1 fully upwind), the
+// first-order upwind terms inside it, and the faces next to a wall, an inflow or an outflow
+// keep their two-point fluxes (the same rule holds there with T3 = the central terms).
+TEST_CASE("upwind3: the blend and the sponge weights, bounded sides", "[fluid][upwind]") {
+  const int nx = 14, ny = 9;
+  AxisSpec ax{nx, 1.4, 0.0}, ay{ny, 0.9, 0.0};
+  ax.sponge_cells = 4;
+  ax.sponge_ratio = 1.2;
+  const Grid g(ax, ay);
+  const int n = g.nx();
+  Field u(n + 1, ny), v(n, ny + 1);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> d(-1, 1);
+  for (double& x : u.a) x = d(rng);
+  for (double& x : v.a) x = d(rng);
+  auto terms = [&](double b, bool up3, bool full) {
+    Field hu(n + 1, ny), hv(n, ny + 1);
+    SpongeWeights sw = sponge_weights(g, b);
+    if (full) {
+      std::fill(sw.centre.begin(), sw.centre.end(), 1.0);
+      std::fill(sw.face.begin(), sw.face.end(), 1.0);
+    }
+    momentum_terms(g, sw, u, v, 0.0, 1, 1, hu, hv, nullptr, nullptr);
+    if (up3) upwind3_terms(g, sw, u, v, OuterRows{}, OuterRows{}, 1, 1, hu, hv);
+    return std::pair{hu, hv};
+  };
+  const double b = 0.3;
+  const auto [t3, s3] = terms(0.0, true, false);
+  const auto [t1, s1] = terms(0.0, false, true);
+  const auto [tb, sb] = terms(b, true, false);
+  const auto [tc, sc] = terms(0.0, false, false);
+  const int start = g.x().sponge_start();
+  double dev = 0, act = 0, wall = 0;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 1; i < n; ++i) {
+      // u face i reads the cells i - 1 and i and its own column's weight.
+      const double want = i - 1 >= start ? t1(i, j)
+                          : i < start    ? (1 - b) * t3(i, j) + b * t1(i, j)
+                                         : tb(i, j);
+      dev = std::max(dev, std::abs(tb(i, j) - want));
+      act = std::max(act, std::abs(t3(i, j) - tc(i, j)));
+    }
+  for (int j = 1; j < ny; ++j)
+    for (int i = 0; i < n; ++i) {
+      const double want = i - 1 >= start  ? s1(i, j)
+                          : i + 1 < start ? (1 - b) * s3(i, j) + b * s1(i, j)
+                                          : sb(i, j);
+      dev = std::max(dev, std::abs(sb(i, j) - want));
+    }
+  // The first u row above the bottom wall: its y fluxes keep two points (the corner below row 1
+  // would need row -1), so only the x fluxes differ from the central terms.
+  for (int i = 2; i + 2 < start; ++i) {
+    const double cx = [&] {
+      auto flux = [&](int c) {
+        const double a = 0.5 * (u(c, 0) + u(c + 1, 0));
+        const double m = u(c - 1, 0), l = u(c, 0), r = u(c + 1, 0), p = u(c + 2, 0);
+        const double q = a > 0 ? (-m + 5 * l + 2 * r) / 6 : (2 * l + 5 * r - p) / 6;
+        return a * (q - 0.5 * (l + r));
+      };
+      return -(flux(i) - flux(i - 1)) / 0.1;
+    }();
+    wall = std::max(wall, std::abs(t3(i, 0) - (tc(i, 0) + cx)));
+  }
+  INFO("upwind3 against central " << act);
+  CHECK(act > 0.1);
+  CHECK(dev < 1e-12);
+  CHECK(wall < 1e-12);
+}
+
+namespace {
+// A wave v = A sin(k x) carried by u = c through a periodic 32 x 4 grid of unit length for one
+// time unit: the amplitude left after it, measured by projection on sin and cos.
+double wave_left(bool up3, double blend, double c, int cells_per_wave) {
+  Config cfg;
+  cfg.density = 1;
+  cfg.viscosity = 1e-12;
+  const int n = 32;
+  cfg.x = {n, 1.0, 0.0};
+  cfg.y = {4, 0.125, 0.0};
+  for (auto& b : cfg.bc) b.type = BcType::periodic;
+  cfg.upwind3 = up3;
+  cfg.upwind_blend = blend;
+  const double dt = 0.002;
+  Solver s(cfg, dt);
+  const double k = 2 * std::numbers::pi * n / cells_per_wave;
+  for (double& x : s.u().a) x = c;
+  Field& v = s.v();
+  for (int j = v.jlo - 1; j <= v.jhi; ++j)
+    for (int i = -1; i <= n; ++i) v(i, j) = std::sin(k * (i + 0.5) / n);
+  for (int step = 0; step < 500; ++step) s.step(dt);
+  double a = 0, b = 0;
+  for (int i = 0; i < n; ++i) {
+    a += s.v()(i, 2) * std::sin(k * (i + 0.5) / n);
+    b += s.v()(i, 2) * std::cos(k * (i + 0.5) / n);
+  }
+  return 2.0 / n * std::hypot(a, b);
+}
+}  // namespace
+
+// Through the whole solver: the third-order scheme damps a wave of kh = theta at the rate of
+// its fourth difference, (4/3) sin^4(theta/2) |c| / h, in either direction of the flow; with
+// the central fluxes it keeps its amplitude (but for the time integrator's growth); the upwind
+// blend b damps at b 2 sin^2(theta/2) |c| / h, far more on the longer wave.
+TEST_CASE("upwind3: a carried wave decays at the scheme's rate", "[fluid][upwind]") {
+  const double h = 1.0 / 32;
+  for (int cells : {8, 16}) {
+    const double th = 2 * std::numbers::pi / cells, s2 = std::pow(std::sin(th / 2), 2);
+    const double rate3 = 4.0 / 3.0 * s2 * s2 / h, rate_b = 0.2 * 2 * s2 / h;
+    for (double c : {1.0, -1.0}) {
+      const double left = wave_left(true, 0.0, c, cells);
+      INFO(cells << " cells a wave, c = " << c << ": left " << left << " against "
+                 << std::exp(-rate3));
+      CHECK(std::abs(std::log(left) + rate3) < 0.01 * rate3 + 1e-3);
+    }
+    const double central = wave_left(false, 0.0, 1.0, cells);
+    const double blend = wave_left(false, 0.2, 1.0, cells);
+    INFO(cells << " cells a wave: central " << central << ", blend 0.2 " << blend << " against "
+               << std::exp(-rate_b));
+    // Central fluxes: no damping; the growth is the time integrator's on an imaginary rate
+    // i y / dt, y = sin(theta) |c| dt / h: Euler's first step |1 + i y| ~ 1 + y^2/2, then AB2's
+    // 1 + y^4/4 per step.
+    const double y = std::sin(th) * 0.002 / h;
+    const double growth = (1 + y * y / 2) * std::pow(1 + std::pow(y, 4) / 4, 499);
+    CHECK(std::abs(central - growth) < 2e-4);
+    CHECK(std::abs(std::log(blend) + rate_b) < 0.01 * rate_b + 1e-3);
+  }
 }
