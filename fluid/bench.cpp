@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "dense_transform.hpp"
+#include "momentum.hpp"
 #include "solver.hpp"
 
 using namespace fluid;
@@ -142,6 +143,33 @@ int main(int argc, char** argv) {
                             {"poisson_floor_ms", floor * 1e3},
                             {"step_to_floor_ratio", ratio},
                             {"poisson_to_floor_ratio", poisson_ratio}});
+    }
+  }
+  // The convective terms alone on the vocal folds' grid (560 + 40 sponge cells by 100): central
+  // fluxes, the upwind blend 0.2, and the third-order upwind correction added to either.
+  {
+    AxisSpec ax{560, 5.6, 0.0}, ay{100, 1.0, 0.0};
+    ax.sponge_cells = 40;
+    ax.sponge_ratio = 1.05;
+    const Grid g(ax, ay);
+    const int nx = g.nx(), ny = g.ny();
+    Field u(nx + 1, ny), v(nx, ny + 1), hu(nx + 1, ny), hv(nx, ny + 1);
+    for (std::size_t q = 0; q < u.a.size(); ++q) u.a[q] = std::sin(0.37 * double(q));
+    for (std::size_t q = 0; q < v.a.size(); ++q) v.a[q] = std::cos(0.29 * double(q));
+    fmt::print("\nconvective terms on 600 x 100 (vocal folds), ms per call\n");
+    j["convection"] = nlohmann::json::array();
+    for (const double b : {0.0, 0.2}) {
+      const SpongeWeights sw = sponge_weights(g, b);
+      const double two = seconds_per_call(
+          [&] { momentum_terms(g, sw, u, v, 1e-3, 1, 1, hu, hv, nullptr, nullptr); }, 0.1 * budget);
+      const double three = seconds_per_call(
+          [&] {
+            momentum_terms(g, sw, u, v, 1e-3, 1, 1, hu, hv, nullptr, nullptr);
+            upwind3_terms(g, sw, u, v, OuterRows{}, OuterRows{}, 1, 1, hu, hv);
+          },
+          0.1 * budget);
+      fmt::print("  blend {:.1f}: two-point {:.3f}, with upwind3 {:.3f}\n", b, two * 1e3, three * 1e3);
+      j["convection"].push_back({{"blend", b}, {"two_point_ms", two * 1e3}, {"upwind3_ms", three * 1e3}});
     }
   }
   // The transforms along t on 600 lines (the vocal folds' channel has 100 (1 + h/D) rows across,

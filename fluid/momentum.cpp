@@ -168,7 +168,6 @@ void upwind3_terms(const Grid& g, const SpongeWeights& sw, const Field& u, const
   const double *ywi = Y.wi(), *ydi = Y.di(), *ylo = Y.wlo(), *yhi = Y.whi();
   const double* bc = sw.centre.data() + 1;
   const double* bf = sw.face.data() + 1;
-  // Row j of f: stored, wrapped (periodic y on one rank) or an outer row (several ranks).
   // The rows filled on every rank are [lo - 1, hi] (hi = u's last stored row; v's top rank
   // stores one more, which a periodic y leaves unfilled there).
   const int hi = u.jhi;
@@ -182,38 +181,61 @@ void upwind3_terms(const Grid& g, const SpongeWeights& sw, const Field& u, const
   auto inside = [](int k, int last, bool periodic) {
     return periodic || (k >= 1 && k + 2 <= last);
   };
+  // A flux along a row (x) at positions [k0, k1], each reading q[k - 1 .. k + 2] with the
+  // carrying velocity a(k) and weight w[k]; q's values are [0, valid] (a bounded row's ghosts
+  // are not read) and stored [-1, last]. The stencil's inner part in one plain loop; the others
+  // wrapped (periodic) or zero (bounded: the two-point flux kept).
   std::vector<double> f(nx + 2), gs(nx + 1), gn(nx + 1);
-
-  // u faces: x fluxes at cells c (between faces c and c + 1), y fluxes at corners (face i, row
-  // boundary j between rows j - 1 and j).
-  const int ju0 = hu.jlo, ju1 = hu.jhi;
-  auto u_corner = [&](int j, std::vector<double>& out) {
-    const bool ok = inside(j - 1, ny - 1, py);
-    const double* r[4] = {nullptr, nullptr, nullptr, nullptr};
-    if (ok)
-      for (int k = 0; k < 4; ++k) r[k] = row(u, ou, j - 2 + k);
-    const double* vr = v.row(j);
-    for (int i = i0; i < nx; ++i) {
-      if (!ok) {
-        out[i] = 0;
+  auto along_x = [&](const double* q, int k0, int k1, int valid, int last, const double* w,
+                     auto&& a, double* out) {
+    const int in0 = std::max(k0, px ? 0 : 1), in1 = std::min(k1, px ? last - 2 : valid - 2);
+    for (int k = in0; k <= in1; ++k) {
+      const double ak = a(k);
+      out[k] = (1.0 - w[k]) * ak * third_order(ak, q[k - 1], q[k], q[k + 1], q[k + 2]);
+    }
+    for (int k = k0; k <= k1; ++k) {
+      if (k >= in0 && k <= in1) continue;
+      if (!px) {
+        out[k] = 0;
         continue;
       }
-      const double a = xlo[i] * vr[i - 1] + xhi[i] * vr[i];
-      out[i] = (1.0 - bf[i]) * a * third_order(a, r[0][i], r[1][i], r[2][i], r[3][i]);
+      const double ak = a(k);
+      out[k] = (1.0 - w[k]) * ak *
+               third_order(ak, q[wrap(k - 1, nx, last, true)], q[k], q[k + 1],
+                           q[wrap(k + 2, nx, last, true)]);
     }
+  };
+  // A flux across rows (y) at row boundary or cell c, reading rows c - off .. c - off + 3 of f.
+  auto across_y = [&](const Field& fld, const OuterRows& o, int c, int off, int last, int k0,
+                      int k1, const double* w, auto&& a, double* out) {
+    if (!inside(c + 1 - off, last, py)) {
+      for (int k = k0; k < k1; ++k) out[k] = 0;
+      return;
+    }
+    const double *r0 = row(fld, o, c - off), *r1 = row(fld, o, c - off + 1),
+                 *r2 = row(fld, o, c - off + 2), *r3 = row(fld, o, c - off + 3);
+    for (int k = k0; k < k1; ++k) {
+      const double ak = a(k, r1, r2);
+      out[k] = (1.0 - w[k]) * ak * third_order(ak, r0[k], r1[k], r2[k], r3[k]);
+    }
+  };
+
+  // u faces: x fluxes at cells c (between faces c and c + 1; u stores faces [-1, nx + 1]), y
+  // fluxes at corners (face i, row boundary j between rows j - 1 and j: rows j - 2 .. j + 1).
+  const int ju0 = hu.jlo, ju1 = hu.jhi;
+  auto u_corner = [&](int j, std::vector<double>& out) {
+    const double* vr = v.row(j);
+    across_y(u, ou, j, 2, ny - 1, i0, nx, bf,
+             [&](int i, const double*, const double*) {
+               return xlo[i] * vr[i - 1] + xhi[i] * vr[i];
+             },
+             out.data());
   };
   if (ju0 < ju1) u_corner(ju0, gs);
   for (int j = ju0; j < ju1; ++j) {
     const double* uc = u.row(j);
-    for (int c = i0 - 1; c < nx; ++c) {
-      if (!inside(c, nx, px)) {
-        f[c + 1] = 0;
-        continue;
-      }
-      const double a = 0.5 * (uc[c] + uc[c + 1]);
-      const double m = uc[wrap(c - 1, nx, nx + 1, px)], p = uc[wrap(c + 2, nx, nx + 1, px)];
-      f[c + 1] = (1.0 - bc[c]) * a * third_order(a, m, uc[c], uc[c + 1], p);
-    }
+    along_x(uc, i0 - 1, nx - 1, nx, nx + 1, bc,
+            [&](int c) { return 0.5 * (uc[c] + uc[c + 1]); }, f.data() + 1);
     u_corner(j + 1, gn);
     double* h = hu.row(j);
     const double ywij = ywi[j];
@@ -221,37 +243,24 @@ void upwind3_terms(const Grid& g, const SpongeWeights& sw, const Field& u, const
     std::swap(gs, gn);
   }
 
-  // v faces: y fluxes at cells c (between faces c and c + 1), x fluxes at corners (column
-  // boundary i between cells i - 1 and i, face row j).
+  // v faces: y fluxes at cells c (between faces c and c + 1: faces c - 1 .. c + 2), x fluxes at
+  // corners (column boundary i between cells i - 1 and i: cells i - 2 .. i + 1; v stores
+  // cells [-1, nx]).
   const int jv0 = std::max(j0, hv.jlo), jv1 = std::min(ny, hv.jhi);
   auto v_cells = [&](int c, std::vector<double>& out) {
-    const bool ok = inside(c, ny, py);
-    const double* r[4] = {nullptr, nullptr, nullptr, nullptr};
-    if (ok)
-      for (int k = 0; k < 4; ++k) r[k] = row(v, ov, c - 1 + k);
-    for (int i = 0; i < nx; ++i) {
-      if (!ok) {
-        out[i] = 0;
-        continue;
-      }
-      const double a = 0.5 * (r[1][i] + r[2][i]);
-      out[i] = (1.0 - bc[i]) * a * third_order(a, r[0][i], r[1][i], r[2][i], r[3][i]);
-    }
+    across_y(v, ov, c, 1, ny, 0, nx, bc,
+             [](int i, const double* r1, const double* r2) { return 0.5 * (r1[i] + r2[i]); },
+             out.data());
   };
   if (jv0 < jv1) v_cells(jv0 - 1, gs);
   for (int j = jv0; j < jv1; ++j) {
     const double* vc = v.row(j);
     const double* uc = u.row(j);
     const double* us = u.row(j - 1);
-    for (int i = 0; i <= nx; ++i) {
-      if (!inside(i - 1, nx - 1, px)) {
-        f[i] = 0;
-        continue;
-      }
-      const double a = ylo[j] * us[i] + yhi[j] * uc[i];
-      const double m = vc[wrap(i - 2, nx, nx, px)], p = vc[wrap(i + 1, nx, nx, px)];
-      f[i] = (1.0 - bf[i]) * a * third_order(a, m, vc[i - 1], vc[i], p);
-    }
+    const double yl = ylo[j], yh = yhi[j];
+    // The corner i's stencil is cells i - 2 .. i + 1: position k = i - 1 of along_x.
+    along_x(vc, -1, nx - 1, nx - 1, nx, bf + 1,
+            [&](int k) { return yl * us[k + 1] + yh * uc[k + 1]; }, f.data() + 1);
     v_cells(j, gn);
     double* h = hv.row(j);
     const double ydj = ydi[j];
