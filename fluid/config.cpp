@@ -433,6 +433,13 @@ Config read_config(const fsi::SceneTable& f, double dt) {
                                  "would aim above the number that stops the run",
                                  c.substeps_cfl, s->has("cfl") ? "" : " (the default)",
                                  c.cfl_max));
+    // AB2 with third-order upwind fluxes: stable to |u| dt/h = 0.58 (1D von Neumann).
+    constexpr double kUpwind3Cfl = 0.58;
+    if (c.upwind3 && c.substeps_cfl > kUpwind3Cfl)
+      s->fail("cfl", fmt::format("{:g}{} is above {:g}, where AB2 with convection = \"upwind3\" "
+                                 "turns unstable: set cfl = 0.5",
+                                 c.substeps_cfl, s->has("cfl") ? "" : " (the default)",
+                                 kUpwind3Cfl));
     s->finish();
   }
   for (Side s : c.wall_shear) {

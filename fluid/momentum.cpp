@@ -159,7 +159,8 @@ inline int wrap(int k, int n, int last, bool periodic) {
 }  // namespace
 
 void upwind3_terms(const Grid& g, const SpongeWeights& sw, const Field& u, const Field& v,
-                   const OuterRows& ou, const OuterRows& ov, int i0, int j0, Field& hu, Field& hv) {
+                   const OuterRows& ou, const OuterRows& ov, int i0, int j0, Field& hu, Field& hv,
+                   std::vector<double>& work) {
   const int nx = g.nx(), ny = g.ny();
   const bool px = g.x().periodic(), py = g.y().periodic();
   const Axis& X = g.x();
@@ -185,7 +186,10 @@ void upwind3_terms(const Grid& g, const SpongeWeights& sw, const Field& u, const
   // carrying velocity a(k) and weight w[k]; q's values are [0, valid] (a bounded row's ghosts
   // are not read) and stored [-1, last]. The stencil's inner part in one plain loop; the others
   // wrapped (periodic) or zero (bounded: the two-point flux kept).
-  std::vector<double> f(nx + 2), gs(nx + 1), gn(nx + 1);
+  work.resize(3 * std::size_t(nx + 2));
+  double* f = work.data();
+  double* gs = f + nx + 2;
+  double* gn = gs + nx + 2;
   auto along_x = [&](const double* q, int k0, int k1, int valid, int last, const double* w,
                      auto&& a, double* out) {
     const int in0 = std::max(k0, px ? 0 : 1), in1 = std::min(k1, px ? last - 2 : valid - 2);
@@ -223,19 +227,19 @@ void upwind3_terms(const Grid& g, const SpongeWeights& sw, const Field& u, const
   // u faces: x fluxes at cells c (between faces c and c + 1; u stores faces [-1, nx + 1]), y
   // fluxes at corners (face i, row boundary j between rows j - 1 and j: rows j - 2 .. j + 1).
   const int ju0 = hu.jlo, ju1 = hu.jhi;
-  auto u_corner = [&](int j, std::vector<double>& out) {
+  auto u_corner = [&](int j, double* out) {
     const double* vr = v.row(j);
     across_y(u, ou, j, 2, ny - 1, i0, nx, bf,
              [&](int i, const double*, const double*) {
                return xlo[i] * vr[i - 1] + xhi[i] * vr[i];
              },
-             out.data());
+             out);
   };
   if (ju0 < ju1) u_corner(ju0, gs);
   for (int j = ju0; j < ju1; ++j) {
     const double* uc = u.row(j);
     along_x(uc, i0 - 1, nx - 1, nx, nx + 1, bc,
-            [&](int c) { return 0.5 * (uc[c] + uc[c + 1]); }, f.data() + 1);
+            [&](int c) { return 0.5 * (uc[c] + uc[c + 1]); }, f + 1);
     u_corner(j + 1, gn);
     double* h = hu.row(j);
     const double ywij = ywi[j];
@@ -247,10 +251,10 @@ void upwind3_terms(const Grid& g, const SpongeWeights& sw, const Field& u, const
   // corners (column boundary i between cells i - 1 and i: cells i - 2 .. i + 1; v stores
   // cells [-1, nx]).
   const int jv0 = std::max(j0, hv.jlo), jv1 = std::min(ny, hv.jhi);
-  auto v_cells = [&](int c, std::vector<double>& out) {
+  auto v_cells = [&](int c, double* out) {
     across_y(v, ov, c, 1, ny, 0, nx, bc,
              [](int i, const double* r1, const double* r2) { return 0.5 * (r1[i] + r2[i]); },
-             out.data());
+             out);
   };
   if (jv0 < jv1) v_cells(jv0 - 1, gs);
   for (int j = jv0; j < jv1; ++j) {
@@ -260,7 +264,7 @@ void upwind3_terms(const Grid& g, const SpongeWeights& sw, const Field& u, const
     const double yl = ylo[j], yh = yhi[j];
     // The corner i's stencil is cells i - 2 .. i + 1: position k = i - 1 of along_x.
     along_x(vc, -1, nx - 1, nx - 1, nx, bf + 1,
-            [&](int k) { return yl * us[k + 1] + yh * uc[k + 1]; }, f.data() + 1);
+            [&](int k) { return yl * us[k + 1] + yh * uc[k + 1]; }, f + 1);
     v_cells(j, gn);
     double* h = hv.row(j);
     const double ydj = ydi[j];

@@ -36,8 +36,9 @@ void momentum_terms(const Grid& g, const SpongeWeights& sw, const Field& u, cons
 // is a second and a third difference added to the two-point value, with these coefficients on
 // stretched cells too (consistent there, of lower order). Where the four values do not exist (the
 // faces next to a non-periodic side) the flux keeps its two-point value. Ghosts of u and v must
-// be filled; on several ranks ou, ov hold the outer rows.
+// be filled; on several ranks ou, ov hold the outer rows. `work` is scratch space (resized once).
 void upwind3_terms(const Grid& g, const SpongeWeights& sw, const Field& u, const Field& v,
-                   const OuterRows& ou, const OuterRows& ov, int i0, int j0, Field& hu, Field& hv);
+                   const OuterRows& ou, const OuterRows& ov, int i0, int j0, Field& hu, Field& hv,
+                   std::vector<double>& work);
 
 }  // namespace fluid

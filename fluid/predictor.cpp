@@ -15,7 +15,8 @@ void Solver::explicit_terms() {
   if (m_cfg.upwind3) {
     m_dec.outer_rows(m_u, m_outer_u);
     m_dec.outer_rows(m_v, m_outer_v);
-    upwind3_terms(m_grid, m_sponge, m_u, m_v, m_outer_u, m_outer_v, m_i0, m_j0, m_hu, m_hv);
+    upwind3_terms(m_grid, m_sponge, m_u, m_v, m_outer_u, m_outer_v, m_i0, m_j0, m_hu, m_hv,
+                  m_upwind3_work);
   }
 }
 

@@ -192,6 +192,7 @@ class Solver {
   Boundaries m_bnd;
   SpongeWeights m_sponge;
   OuterRows m_outer_u, m_outer_v;  // upwind3's rows beyond the slab (several ranks)
+  std::vector<double> m_upwind3_work;  // upwind3_terms scratch
   int m_t_axis = 0;
   int m_i0 = 0, m_j0 = 0;
   // u faces the predictor and the projection step: [m_iu0, m_iu1) (the interior, and the

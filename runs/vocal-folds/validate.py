@@ -60,7 +60,7 @@ P.add_argument("--t-end", type=cli.positive, default=None,
 P.add_argument("--impulsive", action="store_true", help="--run without the inflow ramp")
 P.add_argument("--upwind", type=float, metavar="B", default=None,
                help="--run with fluid.upwind_blend = B (first-order upwind weight outside the sponge); "
-                    "--sweep: default 0.2")
+                    "--sweep: default 0.2 (0 with --convection upwind3)")
 P.add_argument("--p-sub", type=float, metavar="P", default=None,
                help="--run with a pressure inlet: subglottal pressure P (ramped like the inflow), "
                     "pressure 0 at the outlet, instead of the velocity inflow")
@@ -77,7 +77,8 @@ P.add_argument("--wall-planes", action="store_true",
 P.add_argument("--dt", type=cli.positive, default=None,
                help="the coupled runs' time step (default: the scene's, the paper's 5e-5)")
 P.add_argument("--substeps", type=int, metavar="M", default=None,
-               help="the fluid up to M substeps per step, each at a CFL number of at most 0.8")
+               help="the fluid up to M substeps per step, each at a CFL number of at most 0.8 "
+                    "(0.5 with --convection upwind3)")
 P.add_argument("--cover-size", type=cli.positive, metavar="LC", default=None,
                help="the folds' element size within the cover's thickness of the wetted surface "
                     "(fold.geo's lc_cover; default: the element size lc = 0.024 throughout)")

@@ -123,6 +123,12 @@ TEST_CASE("convection: central by default, upwind3, anything else refused",
   CHECK(read(with("convection = \"upwind3\"")).upwind3);
   CHECK_THROWS_WITH(read(with("convection = \"quick\"")),
                     Contains("convection") && Contains("quick") && Contains("upwind3"));
+  // Sub-cycling aims at a CFL number below AB2's limit with these fluxes.
+  const std::string up3 = with("convection = \"upwind3\"");
+  CHECK_NOTHROW(read(up3 + "\n[fluid.substeps]\nmax = 4\ncfl = 0.5\n"));
+  CHECK_THROWS_WITH(read(up3 + "\n[fluid.substeps]\nmax = 4\n"),
+                    Contains("cfl") && Contains("0.8 (the default)") && Contains("upwind3"));
+  CHECK_NOTHROW(read(std::string(kGood) + "\n[fluid.substeps]\nmax = 4\n"));
 }
 
 TEST_CASE("forcing_time: read, refused negative or with the increment forcing",
