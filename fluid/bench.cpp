@@ -217,6 +217,10 @@ int main(int argc, char** argv) {
   fmt::print("  a stretched transform direction by its eigenvectors as a dense product (bands in x "
              "and y at once) | the Poisson floor of 123 rows x 2 (no symmetry to halve the product) | "
              "see the banded 750x123 rows against channel 750x123\n");
+  fmt::print("  fluid.convection = \"upwind3\": its correction as a second pass over the grid, the "
+             "inner loops without index wrapping | about +50 % of the convective terms | see "
+             "\"convective terms\" above (1.26-1.44 -> 1.91-2.37 ms, two runs beside a coupled "
+             "run)\n");
   std::ofstream(out) << j.dump(2) << "\n";
   fmt::print("written {}\n", out);
   return 0;
