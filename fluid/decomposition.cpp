@@ -33,41 +33,38 @@ int Decomposition::owner(int j) const {
   return std::clamp(std::clamp(j, 0, m_ny - 1) / m_block, 0, m_ranks - 1);
 }
 
-void Decomposition::halo(Field& f) const {
-  if (m_ranks == 1) return;
+// One row down and one up: `to_down` to the lower neighbour while `from_up` comes from the upper
+// one, then `to_up` up while `from_down` comes from below (n doubles each; a missing neighbour at
+// a non-periodic end sends and receives nothing). Counted as one halo.
+void Decomposition::swap_rows(const double* to_down, double* from_up, const double* to_up,
+                              double* from_down, int n, int tag) const {
   const bool first = m_rank == 0, last = m_rank == m_ranks - 1;
   const int down = first ? (m_periodic ? m_ranks - 1 : MPI_PROC_NULL) : m_rank - 1;
   const int up = last ? (m_periodic ? 0 : MPI_PROC_NULL) : m_rank + 1;
-  const int n = f.sx;
   const double t0 = MPI_Wtime();
-  // Row lo down (the lower neighbour's row hi), row hi up from it; row hi - 1 up, row lo - 1 in.
-  MPI_Sendrecv(f.row(m_lo) - 1, n, MPI_DOUBLE, down, 7301, f.row(m_hi) - 1, n, MPI_DOUBLE, up,
-               7301, m_comm, MPI_STATUS_IGNORE);
-  MPI_Sendrecv(f.row(m_hi - 1) - 1, n, MPI_DOUBLE, up, 7302, f.row(m_lo - 1) - 1, n, MPI_DOUBLE,
-               down, 7302, m_comm, MPI_STATUS_IGNORE);
+  MPI_Sendrecv(to_down, n, MPI_DOUBLE, down, tag, from_up, n, MPI_DOUBLE, up, tag, m_comm,
+               MPI_STATUS_IGNORE);
+  MPI_Sendrecv(to_up, n, MPI_DOUBLE, up, tag + 1, from_down, n, MPI_DOUBLE, down, tag + 1, m_comm,
+               MPI_STATUS_IGNORE);
   m_traffic.halo_seconds += MPI_Wtime() - t0;
   ++m_traffic.halos;
   m_traffic.halo_bytes += 8.0 * n * ((down != MPI_PROC_NULL) + (up != MPI_PROC_NULL));
 }
 
+// Row lo down (the lower neighbour's row hi), row hi up from it; row hi - 1 up, row lo - 1 in.
+void Decomposition::halo(Field& f) const {
+  if (m_ranks == 1) return;
+  swap_rows(f.row(m_lo) - 1, f.row(m_hi) - 1, f.row(m_hi - 1) - 1, f.row(m_lo - 1) - 1, f.sx,
+            7301);
+}
+
+// Row lo + 1 down (the lower neighbour's hi + 1), row hi - 2 up (the upper one's lo - 2); a slab
+// has at least two rows.
 void Decomposition::outer_rows(const Field& f, OuterRows& o) const {
   if (m_ranks == 1) return;
-  const bool first = m_rank == 0, last = m_rank == m_ranks - 1;
-  const int down = first ? (m_periodic ? m_ranks - 1 : MPI_PROC_NULL) : m_rank - 1;
-  const int up = last ? (m_periodic ? 0 : MPI_PROC_NULL) : m_rank + 1;
-  const int n = f.sx;
-  o.below.resize(n);
-  o.above.resize(n);
-  const double t0 = MPI_Wtime();
-  // Row lo + 1 down (the lower neighbour's hi + 1), row hi - 2 up (the upper one's lo - 2); a
-  // slab has at least two rows.
-  MPI_Sendrecv(f.row(m_lo + 1) - 1, n, MPI_DOUBLE, down, 7303, o.above.data(), n, MPI_DOUBLE, up,
-               7303, m_comm, MPI_STATUS_IGNORE);
-  MPI_Sendrecv(f.row(m_hi - 2) - 1, n, MPI_DOUBLE, up, 7304, o.below.data(), n, MPI_DOUBLE, down,
-               7304, m_comm, MPI_STATUS_IGNORE);
-  m_traffic.halo_seconds += MPI_Wtime() - t0;
-  ++m_traffic.halos;
-  m_traffic.halo_bytes += 8.0 * n * ((down != MPI_PROC_NULL) + (up != MPI_PROC_NULL));
+  o.below.resize(f.sx);
+  o.above.resize(f.sx);
+  swap_rows(f.row(m_lo + 1) - 1, o.above.data(), f.row(m_hi - 2) - 1, o.below.data(), f.sx, 7303);
 }
 
 // Times a collective into the traffic counters.

@@ -77,6 +77,8 @@ class Decomposition {
                    int extra_last_rows = 0) const;
 
  private:
+  void swap_rows(const double* to_down, double* from_up, const double* to_up, double* from_down,
+                 int n, int tag) const;
   template <class F>
   void collective(F&& f) const;
 
