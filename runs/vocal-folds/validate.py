@@ -91,26 +91,19 @@ if not (ARGS.modes or ARGS.short or ARGS.run is not None or ARGS.sweep):
     ARGS.modes = ARGS.short = ARGS.sweep = True
 if ARGS.sweep:
     ARGS.modes = True  # the sweep compares with the fold's eigenfrequencies and mode shapes
-OUT = job.out_dir("vocal-folds")
-if ARGS.material != "saint-venant-kirchhoff":
-    OUT = job.OUT = os.path.join(OUT, ARGS.material)
-    os.makedirs(OUT, exist_ok=True)
-if ARGS.dt is not None:
-    OUT = job.OUT = os.path.join(OUT, f"dt-{ARGS.dt:g}")
-    os.makedirs(OUT, exist_ok=True)
-if ARGS.wall_planes:
-    OUT = job.OUT = os.path.join(OUT, "planes")
-    os.makedirs(OUT, exist_ok=True)
-if ARGS.substeps is not None:
-    OUT = job.OUT = os.path.join(OUT, f"substeps-{ARGS.substeps}")
-    os.makedirs(OUT, exist_ok=True)
-if ARGS.cover_size is not None:
-    OUT = job.OUT = os.path.join(OUT, f"cover-{ARGS.cover_size:g}")
-    os.makedirs(OUT, exist_ok=True)
 UPWIND3 = ARGS.convection == "upwind3"
-if UPWIND3:
-    OUT = job.OUT = os.path.join(OUT, "upwind3")
-    os.makedirs(OUT, exist_ok=True)
+# Each variant's outputs in a folder of their own, nested in this order.
+OUT = job.out_dir("vocal-folds")
+for on, sub in ((ARGS.material != "saint-venant-kirchhoff", ARGS.material),
+                (ARGS.dt is not None, f"dt-{ARGS.dt:g}" if ARGS.dt is not None else ""),
+                (ARGS.wall_planes, "planes"),
+                (ARGS.substeps is not None, f"substeps-{ARGS.substeps}"),
+                (ARGS.cover_size is not None,
+                 f"cover-{ARGS.cover_size:g}" if ARGS.cover_size is not None else ""),
+                (UPWIND3, "upwind3")):
+    if on:
+        OUT = job.OUT = os.path.join(OUT, sub)
+        os.makedirs(OUT, exist_ok=True)
 # The substeps' CFL number: AB2 with third-order upwind fluxes is stable to about 0.58 (1D).
 SUBSTEPS_CFL = 0.5 if UPWIND3 else 0.8
 HERE = os.path.dirname(os.path.abspath(__file__))
