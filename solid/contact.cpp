@@ -354,22 +354,24 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
 //   exactly outside, at a convex and a concave vertex alike; Baerentzen & Aanaes 2005).
 // - A feature with the node behind it by more than the node can have crossed since the step's
 //   start (kSelfCrossing times its motion since relative to the feature's point under it, plus
-//   a floor; at most `reach`, and `reach` when no start positions were given) is the body's
-//   other side, not a contact, and is passed over; except the edges at the slot's front
-//   feature (what it faced at the start of the step, remember_fronts) and at its feature while
-//   it is active (the guarded edges). A node behind a guarded feature by no more than it can
-//   have crossed (the bound above: twice its motion relative to the feature plus a floor, at
-//   most a reach; the nearest such feature, even if a nearer guarded one has the node in front:
-//   it tunnelled through a corner) and in front of it at the step's start, or else behind the
-//   nearest guarded feature however deep, has gone through it: that is its feature, even if the
-//   body's other side is nearer by then.
-//   (Behind a guarded edge beyond that bound or already at the start, and not the nearest,
-//   is no crossing: at a corner of about 90 degrees a node resting on one edge projects inside
-//   the other and behind its line by up to an edge's length; taken as through, a vocal fold's
-//   node touching one edge got a gap of -1.4e-2 from the next, and Newton cycled.) So a node driven
-//   through the surface it faced within one Newton iteration is still caught in the next; a
-//   node driven through a surface that was not its closest at the step's start, deeper than
-//   that bound, would not be.
+//   a floor) is the body's other side, not a contact, and is passed over. For most features the
+//   bound is at most `reach` (and `reach` when no start positions were given); it has no cap at
+//   the guarded edges: those at the slot's front feature (what it faced at the start of the
+//   step, remember_fronts) and at its feature while it is active. A node behind a guarded
+//   feature within the bound, and in front of it at the step's start, has gone through it (the
+//   nearest such feature, even if a nearer guarded one has the node in front: it tunnelled
+//   through a corner): that is its feature, even if the body's other side is nearer by then.
+//   So a node driven through the surface it faced, by a Newton iterate however large, is still
+//   caught in the next; a node driven through a surface that was not its closest at the step's
+//   start, deeper than that bound, would not be.
+//   Behind a guarded feature beyond the bound, or already at the start, is no crossing:
+//   - at a corner of about 90 degrees a node resting on one edge projects inside the other
+//     and behind its line by up to an edge's length; taken as through, a vocal fold's node
+//     touching one edge got a gap of -1.4e-2 from the next, and Newton cycled;
+//   - a short edge of a crumpled surface can turn over between two steps (or a vertex's
+//     pseudo-normal swing past the node) while the node stands still: 3.4e-2 behind the vertex
+//     it faced 3.6e-2 in front of one step earlier, a vocal fold's node was taken as through
+//     it, and the constraint threw the surface by that much in one iteration (Newton diverged).
 // - Within a vertex's zone (kSelfVertexZone) the vertex is the feature, with its pseudo-normal
 //   as the normal, from whichever of its edges it is found; the gap stays the distance.
 // Only features within kSelfSearch reaches are looked for (a box test first).
@@ -457,9 +459,9 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     bool vertex = false;
     bool zone = false;
   };
-  // guarded_near: the nearest guarded feature; crossed: the nearest guarded one the node is
-  // behind by no more than it can have crossed since the step's start.
-  Feature closest, guarded_near, crossed;
+  // crossed: the nearest guarded feature the node is behind by no more than it can have
+  // crossed since the step's start, and was in front of then.
+  Feature closest, crossed;
   const auto& near = surf.self_near[s.slave_node];  // sorted
   const double search = kSelfSearch * reach;
   const std::vector<double>& start = m_start.size() > static_cast<std::size_t>(s.slave_body)
@@ -545,30 +547,30 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     }
     // Behind a feature by more than the node can have crossed since the step's start (it was
     // in front then, or the feature would be guarded): the body's other side.
-    double cross = reach;
+    // A guarded feature's bound has no cap: a Newton iterate may drive a node through what it
+    // faced by more than a reach, and twice the motion still covers that.
+    double cross = guard_edge ? std::numeric_limits<double>::infinity() : reach;
     if (!start.empty()) {
       const double w = std::clamp(xi, 0.0, 1.0);
       auto delta = [&](int v, int c) { return x[2 * v + c] - start[2 * v + c]; };
       auto relative = [&](int c) {
         return delta(s.slave_node, c) - (1 - w) * delta(e[0], c) - w * delta(e[1], c);
       };
-      cross = std::min(reach, kSelfCrossing * std::hypot(relative(0), relative(1)) +
+      cross = std::min(cross, kSelfCrossing * std::hypot(relative(0), relative(1)) +
                                   std::max(kKeepEdge * reach, m_gap_tol));
     }
-    if (g < -cross && !guard_edge) continue;
+    if (g < -cross) continue;
     auto offer = [&](Feature& f) {
       if (rank < f.rank * (1 - kClosestTie) || (rank <= f.rank * (1 + kClosestTie) && interior))
         f = {rank, k, xi, g, n, vertex, in_zone};
     };
     offer(closest);
-    if (guard_edge) offer(guarded_near);
-    if (guard_edge && g < 0 && g >= -cross && in_front_at_start(e, xi, vertex, start)) offer(crossed);
+    if (guard_edge && g < 0 && in_front_at_start(e, xi, vertex, start)) offer(crossed);
   }
-  // Behind what it faced (or touched): that is the contact, even when the body's other side is
-  // nearer by then. Behind a guarded feature by no more than the node can have crossed since
-  // the step's start (the nearest such), or behind the nearest guarded feature however deep.
-  const bool through_near = guarded_near.edge >= 0 && guarded_near.gap < 0;
-  const Feature& f = crossed.edge >= 0 ? crossed : through_near ? guarded_near : closest;
+  // Behind what it faced (or touched) by no more than the node can have crossed since the
+  // step's start: that is the contact (the nearest such), even when the body's other side is
+  // nearer by then.
+  const Feature& f = crossed.edge >= 0 ? crossed : closest;
   const int best_edge = f.edge;
   const double best_xi = f.xi, best_gap = f.gap;
   const Vec2 best_normal = f.normal;

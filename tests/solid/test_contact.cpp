@@ -687,6 +687,37 @@ TEST_CASE("self-contact: behind a guarded edge that is not the nearest is no cro
   }
 }
 
+// Behind the feature it faced by more than it moved is no crossing either: the edge a node faces
+// turned over about the point under the node (its two ends swapped: a crumpled cover's short
+// edge, whose normal swings by 180 degrees between two steps while the node stands still). The
+// node is now 0.05 behind that edge's line with no relative motion; taken as "through what it
+// faced, however deep", it got a gap of -0.05 and its constraint threw the surface by that much
+// within one Newton iteration (a vocal fold's cover, t = 5.8995: Newton diverged). It is the
+// edges beside it, which still face it, that are its feature: in front, at the same distance.
+TEST_CASE("self-contact: a faced edge turned over is no crossing", "[contact]") {
+  const Mesh mesh = u_mesh();
+  const int n = u_node(mesh, 0.15, 0.6);  // the left arm's inner face at y = 0.6
+  const int lo = u_node(mesh, 0.35, 0.6), hi = u_node(mesh, 0.35, 0.65);
+  REQUIRE(n >= 0);
+  REQUIRE(lo >= 0);
+  REQUIRE(hi >= 0);
+  ContactSet set;
+  setup_self_contact(set, mesh);
+  auto slot = [&]() -> const ContactSlot& { return slot_of(set, n); };
+  const std::vector<double> reach = {0.05};
+  std::vector<double> x = mesh.x;
+  x[2 * n] = 0.30, x[2 * n + 1] = 0.625;  // facing the middle of the edge lo-hi, 0.05 away
+  set.detect({&x}, reach);
+  REQUIRE(slot().gap == Approx(0.05));
+  REQUIRE(slot().m1 >= 0);
+  REQUIRE(((slot().m0 == lo && slot().m1 == hi) || (slot().m0 == hi && slot().m1 == lo)));
+  set.remember_fronts({&x});
+  std::swap(x[2 * lo + 1], x[2 * hi + 1]);
+  set.detect({&x}, reach);
+  CHECK(slot().gap == Approx(0.05));
+  CHECK(slot().normal[0] == Approx(-1.0));
+}
+
 // The contact working set's growth (solve_contact): a stiff bar pushed down at its middle, over
 // a fixed rigid block under its left end (near) and a plane under the whole bar (farther). The
 // step without contact moves the bar down as a whole: its left end through the block, the rest
