@@ -302,6 +302,12 @@ SETTLE = 1.0
 SUSTAINED, MOVES = 0.5, 1e-6
 # The paper's findings on "about a tenth": a ratio of the impulses within a factor 2 of 0.1.
 TENTH = (0.05, 0.2)
+# A closure of the glottis: the folds touch each other, which alone presses the lower fold
+# towards its wall (its contact force's y component below -CLOSED; the wall plane pushes it
+# away from the wall, and self-contact sums to zero over the fold). Active contact slots
+# count self-contact and the planes too. CLOSED is in the scene's units (rho_f u_m^2 D), a
+# thousandth of the fluid's force on a fold; episodes less than CLOSURE_GAP apart are one.
+CLOSED, CLOSURE_GAP = 1e-3, 0.05
 
 
 def read_csv(path):
@@ -436,7 +442,10 @@ def sweep_case(h, p_sub, grid, t_end, upwind, modes_f):
     row["measured"] = bool(window >= 3 / modes_f[0])
     row["f_dominant"] = row["nearest_mode"] = row["f_zero_crossings"] = None
     row["amplitude_uy"] = float(np.ptp(probes["B_lower.uy"][m])) if m.any() else None
-    if m.sum() > 8:
+    # A spectrum needs two periods of the highest frequency looked for in the window (a run
+    # that has just started has none).
+    spectral = bool(m.sum() > 8 and window > 2 / (3 * modes_f[2]))
+    if spectral:
         f, X = spectrum(t[m], probes["B_lower.uy"][m])
         # From two periods in the window (below: what the mean removal and window leave of a
         # drift) to three times the third eigenfrequency.
@@ -449,21 +458,28 @@ def sweep_case(h, p_sub, grid, t_end, upwind, modes_f):
         keep = f <= 3 * modes_f[2]
         data["spectrum"] = (f[keep], X[keep])
     row["vibrates"] = False
-    if m.sum() > 8:
+    if spectral:
         thirds = np.array_split(probes["B_lower.uy"][m], 3)
         row["sustained_ratio"] = float(np.ptp(thirds[2]) / max(np.ptp(thirds[0]), 1e-300))
         row["vibrates"] = bool(row["amplitude_uy"] >= MOVES and row["sustained_ratio"] >= SUSTAINED
                                and not row["peak_at_edge"])
-    # Contact: any active contact, its first and last time, and during the vibration (t >= 1).
+    # Contact between the folds (closures, CLOSED): the first and last time, during the
+    # vibration (t >= 1), the closures (episodes); and the last time of any active slot.
     if hist is not None:
         row["contact"] = row["contact_after_settle"] = False
-        row["contact_first"] = row["contact_last"] = None
+        row["contact_first"] = row["contact_last"] = row["any_contact_last"] = None
+        row["closures"] = 0
+        t = hist["time"]
+        closed = hist["lower.contact_fy"] < -CLOSED
+        if closed.any():
+            tc = t[closed]
+            row.update(contact=True, contact_first=float(tc[0]), contact_last=float(tc[-1]),
+                       contact_steps=int(closed.sum()),
+                       contact_after_settle=bool((closed & (t >= SETTLE)).any()),
+                       closures=int(1 + np.count_nonzero(np.diff(tc) > CLOSURE_GAP)))
         active = hist["active_contacts"] > 0
         if active.any():
-            row.update(contact=True, contact_first=float(hist["time"][active][0]),
-                       contact_last=float(hist["time"][active][-1]),
-                       contact_steps=int(active.sum()),
-                       contact_after_settle=bool((active & (hist["time"] >= SETTLE)).any()))
+            row["any_contact_last"] = float(t[active][-1])
         row["min_gap"] = float(np.min(hist["min_gap"]))
     # Forces on the lower fold and their impulses: the whole run and t >= 1.
     if hist is not None and forces is not None:
@@ -509,12 +525,12 @@ def axis_angle(d):
 
 
 def output_gaps(folder, hist):
-    """[(key, time)] of solid.h5's output steps, the smallest gap between the folds and whether
-    contact is active there (solid_history.csv's row nearest in time)."""
+    """[(key, time)] of solid.h5's output steps, the smallest contact gap and whether the folds
+    touch each other there (CLOSED; solid_history.csv's row nearest in time)."""
     with h5py.File(os.path.join(folder, "solid.h5"), "r") as s:
         steps = [(k, float(s[k].attrs["time"])) for k in outputs.step_keys(s)]
     rows = [int(np.argmin(np.abs(hist["time"] - tm))) for _, tm in steps]
-    return steps, hist["min_gap"][rows], hist["active_contacts"][rows] > 0
+    return steps, hist["min_gap"][rows], hist["lower.contact_fy"][rows] < -CLOSED
 
 
 def draw_field(a, folder, step, time_s, title):
@@ -697,14 +713,14 @@ if ARGS.sweep:
     print(f"\nsweep ({ARGS.grid} grid, t_end {t_end:g}, convection {ARGS.convection}, upwind_blend {upwind:g}); spectra over t >= {SETTLE}; "
           f"modes of one fold {', '.join(f'{v:.3f}' for v in f1)}")
     print(f"{'h/D':>5} {'inlet':<13} {'Re':>6} {'end':>7} {'f_dom':>7} {'f_0x':>7} {'mode':>10} "
-          f"{'amp B.uy':>9} {'contact':>15} {'wall s':>7}  state / error")
+          f"{'amp B.uy':>9} {'closures':>15} {'wall s':>7}  state / error")
     for r in rows:
         fd = "-" if r.get("f_dominant") is None else f"{r['f_dominant']:.3f}" + ("" if r["measured"] else "*")
         f0 = "-" if r.get("f_zero_crossings") is None else f"{r['f_zero_crossings']:.3f}"
         mode = "-" if r.get("nearest_mode") is None else f"{r['nearest_mode'][0]} ({r['nearest_mode'][1]:.3f})"
         amp = "-" if r.get("amplitude_uy") is None else f"{r['amplitude_uy']:.2e}"
         con = "-" if "contact" not in r else \
-            f"yes {r['contact_first']:.4f}-{r['contact_last']:.4f}" if r["contact"] else "no"
+            f"{r['closures']}: {r['contact_first']:.2f}-{r['contact_last']:.2f}" if r["contact"] else "no"
         wall = "-" if r["wall_s"] is None else ("~" if r.get("wall_approx") else "") + f"{r['wall_s']:.0f}"
         end = "-" if r["end"] is None else f"{r['end']:.3f}"
         print(f"{r['h']:>5g} {r['inlet']:<13} {r['Re']:>6.0f} {end:>7} {fd:>7} {f0:>7} {mode:>10} {amp:>9} "
@@ -729,6 +745,7 @@ if ARGS.sweep:
             metrics[f"{key}_uy_amplitude"] = reported(r["amplitude_uy"])
         if "contact" in r:
             metrics[f"{key}_contact"] = reported(float(r["contact"]))
+            metrics[f"{key}_closures"] = reported(float(r["closures"]))
         if r.get("impulse_ratio") is not None and r["h"] == 0:
             metrics[f"{key}_contact_over_fluid_impulse"] = reported(r["impulse_ratio"], 0.1)
     # The paper's findings, on the runs whose window after t = 1 holds three periods of mode 1.
@@ -744,7 +761,7 @@ if ARGS.sweep:
     def contact(r):
         return (r["contact_after_settle"] == (r["h"] <= 0.01),
                 {"contact_after_t_settle": r["contact_after_settle"], "contact_first": r["contact_first"],
-                 "contact_last": r["contact_last"]})
+                 "contact_last": r["contact_last"], "closures": r["closures"]})
 
     findings = [
         finding("small clearances (h <= 0.02) vibrate near mode 2", [r for r in vel if r["h"] <= 0.02],
