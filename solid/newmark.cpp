@@ -72,6 +72,7 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
   // The linearised reaction of coupled iterations is about the velocity at t^(n+1): a step that
   // carries it is not cut.
   const int cutbacks = m_iteration_velocity ? 0 : m_model.settings.step_cutbacks;
+  m_failed_start_kept = false;
   try {
     rep = newmark_span(dt, external, when, cutbacks, 1);
   } catch (...) {
@@ -113,10 +114,19 @@ StepReport Solver::newmark_span(double dt, const std::vector<std::vector<double>
     }
   }
   restore_state(start);
-  StepReport first = newmark_span(dt / 2, external, when, cutbacks - 1, 2 * parts);
+  StepReport first, rep;
   std::vector<std::vector<double>> contact;
-  for (const auto& b : m_bodies) contact.push_back(b->contact);
-  StepReport rep = newmark_span(dt / 2, external, when, cutbacks - 1, 2 * parts);
+  try {
+    first = newmark_span(dt / 2, external, when, cutbacks - 1, 2 * parts);
+    for (const auto& b : m_bodies) contact.push_back(b->contact);
+    rep = newmark_span(dt / 2, external, when, cutbacks - 1, 2 * parts);
+  } catch (const StepFailed&) {
+    if (parts == 1) {  // the whole step failed: keep where it started (failed_step_start)
+      m_failed_start = std::move(start);
+      m_failed_start_kept = true;
+    }
+    throw;
+  }
   for (std::size_t b = 0; b < m_bodies.size(); ++b)
     for (std::size_t d = 0; d < contact[b].size(); ++d)
       m_bodies[b]->contact[d] = 0.5 * (contact[b][d] + m_bodies[b]->contact[d]);

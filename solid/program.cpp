@@ -196,7 +196,19 @@ void SolidProgram::advance(const fsi::proto::StepBegin& sb, const fsi::proto::So
                                  in.root_mass.empty() ? nullptr : &in.root_mass);
     }
   } catch (const fsi::Error&) {
-    write_fields(sb.step + 1, sb.time + sb.dt);  // the last state, for a look at what went wrong
+    // For a look at what went wrong: the last converged state (t^n, when the step's cutbacks
+    // kept it), then the failed attempt's last iterate (at t^n + dt), which is no solution.
+    if (const StepState* start = m_solver->failed_step_start()) {
+      StepState failed;
+      m_solver->save_state(failed);
+      m_solver->restore_state(*start);
+      write_fields(sb.step, sb.time);
+      m_solver->restore_state(failed);
+      std::fprintf(stderr, "[solid] the last converged state (t = %.9g) and the failed step's last "
+                   "iterate (t = %.9g, no solution) are the last two outputs\n", sb.time,
+                   sb.time + sb.dt);
+    }
+    write_fields(sb.step + 1, sb.time + sb.dt);
     throw;
   }
   if (sb.iteration == 0)

@@ -136,6 +136,9 @@ class Solver {
   // the step from it and gives bit for bit what it gave the first time with the same forces).
   void save_state(StepState& s) const;
   void restore_state(const StepState& s);
+  // After advance() failed with cutbacks: the state the failed step started from (the last
+  // converged one), for the output of a stopped run; nullptr otherwise (no cutbacks: none kept).
+  const StepState* failed_step_start() const { return m_failed_start_kept ? &m_failed_start : nullptr; }
 
   // Static analysis: the loads and prescribed displacements scaled by k / load_steps,
   // k = 1 ... load_steps, each solved by Newton. Returns the report of every load step.
@@ -271,6 +274,8 @@ class Solver {
   long m_factorizations = 0;
   long m_working_set_growths = 0;
   long m_cut_steps = 0, m_cutback_notes = 0;  // advance(): steps cut back, notes printed
+  StepState m_failed_start;  // failed_step_start()
+  bool m_failed_start_kept = false;
   // A dynamic step may start with the factor the last one solved with (newton.cpp, kKeepRatio):
   // allowed during advance(), earned by the last step's first contraction.
   bool m_keep_allowed = false;
