@@ -30,10 +30,11 @@ constexpr double kSelfSearch = 4;
 // the vertex is already its feature as a zone) touches the vertex, with the vertex's pseudo-normal as the
 // gap's gradient (detect_self).
 constexpr double kSelfVertexZone = 0.01;
-// Self-contact: a node behind a feature it did not face at the step's start is the body's other
-// side unless it is within this many times its motion since, relative to the feature's point
-// under it (plus the accepted gap, at least kKeepEdge reaches; at most one reach). Behind a
-// guarded feature within that bound, the node went through it (detect_self).
+// Self-contact: a node behind a feature is the body's other side unless it is within this many
+// times its motion since the step's start, relative to the feature's point under it (plus the
+// accepted gap, at least kKeepEdge reaches; at most one reach, except at the guarded features:
+// what it faced at the step's start or touches now). Behind a guarded feature within that bound,
+// having been in front of it at the start, the node went through it (detect_self).
 constexpr double kSelfCrossing = 2;
 const std::vector<double> kNoPositions;
 
@@ -545,10 +546,10 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
       n = {sign * qx / d, sign * qy / d};
       g = sign * d;
     }
-    // Behind a feature by more than the node can have crossed since the step's start (it was
-    // in front then, or the feature would be guarded): the body's other side.
-    // A guarded feature's bound has no cap: a Newton iterate may drive a node through what it
-    // faced by more than a reach, and twice the motion still covers that.
+    // Behind a feature by more than the node can have crossed since the step's start: the
+    // body's other side. A guarded feature's bound has no cap: a Newton iterate may drive a
+    // node through what it faced by more than a reach, and twice the motion still covers that
+    // (without start positions: any depth).
     double cross = guard_edge ? std::numeric_limits<double>::infinity() : reach;
     if (!start.empty()) {
       const double w = std::clamp(xi, 0.0, 1.0);

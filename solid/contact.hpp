@@ -53,7 +53,7 @@ class ContactSet {
   // the coming step (detect_self), and the positions x (one vector per body) the step starts
   // from; gap_tol is the accepted gap (a slot that far inside keeps its front). Called at the
   // start of every step from the last detection. Without positions, a node may be found up
-  // to one reach behind any feature (see detect_self).
+  // to one reach behind any feature, and at any depth behind a guarded one (see detect_self).
   void remember_fronts(const std::vector<const std::vector<double>*>& x = {}, double gap_tol = 0);
   std::vector<ContactSlot>& slots() { return m_slots; }
   const std::vector<ContactSlot>& slots() const { return m_slots; }

@@ -49,6 +49,7 @@ void Solver::factorize_ahead(double dt) {
 StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* external,
                            const std::vector<std::vector<double>>* iteration_velocity,
                            const std::vector<std::vector<double>>* root_mass) {
+  m_failed_start_kept = false;
   if (!(dt > 0)) fsi::fail("time step must be > 0, got {}", dt);
   if (m_bodies.empty()) {  // a scene without bodies: only the clock moves
     m_time += dt;
@@ -72,7 +73,6 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
   // The linearised reaction of coupled iterations is about the velocity at t^(n+1): a step that
   // carries it is not cut.
   const int cutbacks = m_iteration_velocity ? 0 : m_model.settings.step_cutbacks;
-  m_failed_start_kept = false;
   try {
     rep = newmark_span(dt, external, when, cutbacks, 1);
   } catch (...) {

@@ -196,17 +196,23 @@ void SolidProgram::advance(const fsi::proto::StepBegin& sb, const fsi::proto::So
                                  in.root_mass.empty() ? nullptr : &in.root_mass);
     }
   } catch (const fsi::Error&) {
-    // For a look at what went wrong: the last converged state (t^n, when the step's cutbacks
-    // kept it), then the failed attempt's last iterate (at t^n + dt), which is no solution.
-    if (const StepState* start = m_solver->failed_step_start()) {
+    // For a look at what went wrong: the state the failed step started from (t^n, the last
+    // converged one), kept by the step's cutbacks or by coupled iterations, then the failed
+    // attempt's last iterate (of the step or of a part of it), no solution, as the step's end.
+    // Best effort: an error while writing these leaves the step's own error to report.
+    const StepState* start = m_solver->failed_step_start();
+    if (!start && m_start_step == sb.step) start = &m_start;
+    if (start) {
       StepState failed;
       m_solver->save_state(failed);
-      m_solver->restore_state(*start);
-      write_fields(sb.step, sb.time);
+      try {
+        m_solver->restore_state(*start);
+        write_fields(sb.step, sb.time);
+        std::fprintf(stderr, "[solid] the state the failed step started from (t = %.9g) and its "
+                     "last iterate (no solution) are the last two outputs\n", sb.time);
+      } catch (const std::exception&) {
+      }
       m_solver->restore_state(failed);
-      std::fprintf(stderr, "[solid] the last converged state (t = %.9g) and the failed step's last "
-                   "iterate (t = %.9g, no solution) are the last two outputs\n", sb.time,
-                   sb.time + sb.dt);
     }
     write_fields(sb.step + 1, sb.time + sb.dt);
     throw;

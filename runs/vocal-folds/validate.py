@@ -302,12 +302,19 @@ SETTLE = 1.0
 SUSTAINED, MOVES = 0.5, 1e-6
 # The paper's findings on "about a tenth": a ratio of the impulses within a factor 2 of 0.1.
 TENTH = (0.05, 0.2)
-# A closure of the glottis: the folds touch each other, which alone presses the lower fold
-# towards its wall (its contact force's y component below -CLOSED; the wall plane pushes it
-# away from the wall, and self-contact sums to zero over the fold). Active contact slots
-# count self-contact and the planes too. CLOSED is in the scene's units (rho_f u_m^2 D), a
-# thousandth of the fluid's force on a fold; episodes less than CLOSURE_GAP apart are one.
+# A closure of the glottis: the folds touch each other, which alone presses a fold towards its
+# wall (the lower fold's contact force's y component below -CLOSED, or the upper fold's above
+# CLOSED; a wall plane pushes its fold away from the wall, and self-contact sums to zero over
+# a fold; either fold's sum may be cancelled by its plane at a time, hence both). Active
+# contact slots count self-contact and the planes too. CLOSED is in the scene's units
+# (rho_f u_m^2 D), a thousandth of the fluid's force on a fold; episodes less than CLOSURE_GAP
+# apart are one.
 CLOSED, CLOSURE_GAP = 1e-3, 0.05
+
+
+def folds_touch(hist):
+    """Per row of solid_history.csv: whether the folds press on each other (CLOSED)."""
+    return (hist["lower.contact_fy"] < -CLOSED) | (hist["upper.contact_fy"] > CLOSED)
 
 
 def read_csv(path):
@@ -469,17 +476,17 @@ def sweep_case(h, p_sub, grid, t_end, upwind, modes_f):
         row["contact"] = row["contact_after_settle"] = False
         row["contact_first"] = row["contact_last"] = row["any_contact_last"] = None
         row["closures"] = 0
-        t = hist["time"]
-        closed = hist["lower.contact_fy"] < -CLOSED
+        th = hist["time"]
+        closed = folds_touch(hist)
         if closed.any():
-            tc = t[closed]
+            tc = th[closed]
             row.update(contact=True, contact_first=float(tc[0]), contact_last=float(tc[-1]),
                        contact_steps=int(closed.sum()),
-                       contact_after_settle=bool((closed & (t >= SETTLE)).any()),
+                       contact_after_settle=bool((closed & (th >= SETTLE)).any()),
                        closures=int(1 + np.count_nonzero(np.diff(tc) > CLOSURE_GAP)))
         active = hist["active_contacts"] > 0
         if active.any():
-            row["any_contact_last"] = float(t[active][-1])
+            row["any_contact_last"] = float(th[active][-1])
         row["min_gap"] = float(np.min(hist["min_gap"]))
     # Forces on the lower fold and their impulses: the whole run and t >= 1.
     if hist is not None and forces is not None:
@@ -530,7 +537,7 @@ def output_gaps(folder, hist):
     with h5py.File(os.path.join(folder, "solid.h5"), "r") as s:
         steps = [(k, float(s[k].attrs["time"])) for k in outputs.step_keys(s)]
     rows = [int(np.argmin(np.abs(hist["time"] - tm))) for _, tm in steps]
-    return steps, hist["min_gap"][rows], hist["lower.contact_fy"][rows] < -CLOSED
+    return steps, hist["min_gap"][rows], folds_touch(hist)[rows]
 
 
 def draw_field(a, folder, step, time_s, title):

@@ -1,6 +1,7 @@
 #!/usr/bin/python3
-"""A stopped run's last two outputs: the last converged state (t^n) and the failed step's last
-iterate (t^n + dt). The first must be the state a run ending at t^n writes, bit for bit.
+"""A stopped run's last two outputs: the state the failed step started from (t^n, the last
+converged one) and the failed attempt's last iterate (stored at t^n + dt). The first must be the
+state a run ending at t^n writes, bit for bit.
 
 usage: failed_step_output.py SOLID SCENE WORKDIR
 """
@@ -17,7 +18,7 @@ failed = subprocess.run([solid, scene, "--out-dir", os.path.join(work, "failed")
                         capture_output=True, text=True)
 assert failed.returncode != 0, "the run was to stop at step 6"
 assert "[solid] ERROR: Newton did not converge in 3 iterations at step 6" in failed.stderr, failed.stderr
-assert "the last converged state (t = 0.05)" in failed.stderr, failed.stderr
+assert "the state the failed step started from (t = 0.05)" in failed.stderr, failed.stderr
 # The same scene ending at t = 0.05, which converges every step.
 with open(scene) as f:
     text = f.read().replace("t_end = 0.1\n", "t_end = 0.05\n")

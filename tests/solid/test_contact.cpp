@@ -649,7 +649,7 @@ TEST_CASE("self-contact: behind a guarded edge that is not the nearest is no cro
   CHECK(slot().normal[0] == Approx(1.0));
   // The mirror (a fresh set): from above the top edge, facing it, driven through the corner to
   // the same place within the step (0.05 of motion): behind the top edge by 0.04, within the
-  // bound (twice the motion, capped at the reach 0.05), so it went through the top edge, though
+  // bound (twice the motion), so it went through the top edge, though
   // the inner face is nearer and in front.
   ContactSet mirror;
   setup_self_contact(mirror, mesh);
@@ -665,7 +665,7 @@ TEST_CASE("self-contact: behind a guarded edge that is not the nearest is no cro
   CHECK(mslot().m1 == top);
   CHECK(mslot().gap == Approx(-0.04).epsilon(0.01));
   // Behind the top edge's line already at the step's start, by 0.04, and moving 0.03 (twice
-  // that, capped at the reach, is more than 0.04): the crossing bound alone would take the top
+  // that is more than 0.04): the crossing bound alone would take the top
   // edge (gap −0.04) in this iteration and not in one where the node had moved 0.015. The node
   // was not in front of the top edge at the start, so it did not go through it: in both, the
   // inner face it faced.
@@ -711,11 +711,50 @@ TEST_CASE("self-contact: a faced edge turned over is no crossing", "[contact]") 
   REQUIRE(slot().gap == Approx(0.05));
   REQUIRE(slot().m1 >= 0);
   REQUIRE(((slot().m0 == lo && slot().m1 == hi) || (slot().m0 == hi && slot().m1 == lo)));
+  const std::vector<double> facing = x;
+  // Turned over within the step: the node was in front of it at the step's start.
   set.remember_fronts({&x});
   std::swap(x[2 * lo + 1], x[2 * hi + 1]);
   set.detect({&x}, reach);
   CHECK(slot().gap == Approx(0.05));
   CHECK(slot().normal[0] == Approx(-1.0));
+  // Turned over before the step: the slot's feature is still that edge (as when the edge the
+  // node faced was next to a vertex whose pseudo-normal had swung past the node: the vertex's
+  // edges become guarded), and the node is behind it at the step's start too.
+  ContactSet before;
+  setup_self_contact(before, mesh);
+  auto bslot = [&]() -> const ContactSlot& { return slot_of(before, n); };
+  std::vector<double> y = facing;
+  before.detect({&y}, reach);
+  REQUIRE(bslot().gap == Approx(0.05));
+  std::swap(y[2 * lo + 1], y[2 * hi + 1]);
+  before.remember_fronts({&y});
+  before.detect({&y}, reach);
+  CHECK(bslot().gap == Approx(0.05));
+  CHECK(bslot().normal[0] == Approx(-1.0));
+}
+
+// Driven through the face it faced deeper than the reach within the step, with the step's
+// start positions known (as in every Newton iteration): caught, since the bound at a guarded
+// feature is twice the motion without the one-reach cap. (The test above gives no positions.)
+TEST_CASE("self-contact: deeper than a reach through what it faced, start known", "[contact]") {
+  const Mesh mesh = u_mesh();
+  const int n = u_node(mesh, 0.15, 0.6);
+  REQUIRE(n >= 0);
+  ContactSet set;
+  setup_self_contact(set, mesh);
+  auto slot = [&]() -> const ContactSlot& { return slot_of(set, n); };
+  const std::vector<double> reach = {0.05};
+  std::vector<double> x = mesh.x;
+  x[2 * n] = 0.25;  // facing the right arm's inner face 0.1 away
+  set.detect({&x}, reach);
+  REQUIRE(slot().gap == Approx(0.1));
+  set.remember_fronts({&x});
+  x[2 * n] = 0.45;  // 0.1 inside the right arm (two reaches), 0.05 from its outer face
+  set.detect({&x}, reach);
+  CHECK(slot().gap == Approx(-0.1));
+  CHECK(slot().normal[0] == Approx(-1.0));
+  CHECK(std::abs(mesh.x[2 * slot().m0] - 0.35) < 1e-12);
 }
 
 // The contact working set's growth (solve_contact): a stiff bar pushed down at its middle, over
