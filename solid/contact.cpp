@@ -370,9 +370,10 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
 //     and behind its line by up to an edge's length; taken as through, a vocal fold's node
 //     touching one edge got a gap of -1.4e-2 from the next, and Newton cycled;
 //   - a short edge of a crumpled surface can turn over between two steps (or a vertex's
-//     pseudo-normal swing past the node) while the node stands still: 3.4e-2 behind the vertex
-//     it faced 3.6e-2 in front of one step earlier, a vocal fold's node was taken as through
-//     it, and the constraint threw the surface by that much in one iteration (Newton diverged).
+//     pseudo-normal swing past the node) while the node stands still: 3.4e-2 behind a vertex
+//     by its pseudo-normal, a vocal fold's node was taken as through it once the feature it
+//     faced was the vertex's neighbour, and the constraint threw the surface by that much in
+//     one iteration (Newton diverged).
 // - Within a vertex's zone (kSelfVertexZone) the vertex is the feature, with its pseudo-normal
 //   as the normal, from whichever of its edges it is found; the gap stays the distance.
 // Only features within kSelfSearch reaches are looked for (a box test first).

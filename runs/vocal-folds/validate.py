@@ -94,14 +94,13 @@ if ARGS.sweep:
 UPWIND3 = ARGS.convection == "upwind3"
 # Each variant's outputs in a folder of their own, nested in this order.
 OUT = job.out_dir("vocal-folds")
-for on, sub in ((ARGS.material != "saint-venant-kirchhoff", ARGS.material),
-                (ARGS.dt is not None, f"dt-{ARGS.dt:g}" if ARGS.dt is not None else ""),
-                (ARGS.wall_planes, "planes"),
-                (ARGS.substeps is not None, f"substeps-{ARGS.substeps}"),
-                (ARGS.cover_size is not None,
-                 f"cover-{ARGS.cover_size:g}" if ARGS.cover_size is not None else ""),
-                (UPWIND3, "upwind3")):
-    if on:
+for sub in (None if ARGS.material == "saint-venant-kirchhoff" else ARGS.material,
+            None if ARGS.dt is None else f"dt-{ARGS.dt:g}",
+            "planes" if ARGS.wall_planes else None,
+            None if ARGS.substeps is None else f"substeps-{ARGS.substeps}",
+            None if ARGS.cover_size is None else f"cover-{ARGS.cover_size:g}",
+            "upwind3" if UPWIND3 else None):
+    if sub:
         OUT = job.OUT = os.path.join(OUT, sub)
         os.makedirs(OUT, exist_ok=True)
 # The substeps' CFL number: AB2 with third-order upwind fluxes is stable to about 0.58 (1D).
