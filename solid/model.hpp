@@ -91,6 +91,10 @@ struct ContactPlane {
 
 enum class Analysis { dynamic, statics };
 
+// Where a dynamic step's Newton starts (newmark.cpp, Solver::predict): at x^n, or at the
+// trapezoidal step taken with the acceleration of the step's start.
+enum class Predictor { none, acceleration };
+
 // Halvings of a failed step at most (Settings::step_cutbacks): dt / 1024, and at most 2^10 parts
 // of one step when every part fails whole.
 constexpr int kMaxStepCutbacks = 10;
@@ -107,6 +111,7 @@ struct Settings {
   int step_cutbacks = 3;
   double contact_tolerance = 1e-10;  // on the gap, relative to the smallest element edge
   bool keep_factor = true;  // a dynamic step may start with the last step's factor (newton.cpp)
+  Predictor predictor = Predictor::none;  // opt-in (solid/README.md, "The predictor")
 };
 
 struct Model {

@@ -142,7 +142,7 @@ StepReport Solver::newmark_span(double dt, const std::vector<std::vector<double>
 StepReport Solver::newmark_step(double dt, const std::vector<std::vector<double>>* external,
                                 const std::string& when) {
   const double t1 = m_time + dt;
-  predict(t1);
+  predict(t1, dt, external);
   m_contact_force_factor = kNewmarkContactForceFactor;
   StepReport rep = newton(newmark_c0(dt), dt, t1, external, when);
   // The next step's tangent (and its look-ahead factorisation) takes this step's root masses.
@@ -165,12 +165,111 @@ void Solver::initial_acceleration(double dt) {
                       : 0.0;
 }
 
-// The predictor: Newton starts from x^n (kept as the step's start), the rigid bodies are moved to
-// t^(n+1), and the prescribed displacements at t^(n+1) wait as an increment for the first solve.
-void Solver::predict(double t1) {
+// The predictor. The step's start is kept (x^n, v^n), the rigid bodies are moved to t^(n+1), the
+// prescribed displacements at t^(n+1) wait as an increment for the first solve, and the
+// self-contact remembers what each node faces at x^n. Then, with settings.predictor =
+// "acceleration", the elastic bodies' free dofs with mass move to the trapezoidal step taken
+// with the forces of the step's start: in the residual (assembly.cpp) put
+// (F - Q)^(n+1) = (F - Q)^n = (M a)^n, keep this step's coupling force F_c and the last step's
+// contact force c^n (each enters twice: 2 F_c, B^T lambda = 2 c):
+//   (4/dt^2) M (x - x^n - dt v^n) = 2 ((M a)^n + F_c + c^n)
+//   x = x^n + dt v^n + (dt^2 / 2) M^-1 ((M a)^n + F_c + c^n),
+// M the consistent mass on the free equations (factorize_mass; a lumped one leaves the rough
+// part of the fluid's force in the first residual). Newton's first residual is then the change
+// of F - Q over the step, not the step's whole inertia (4/dt) M v^n (solid/README.md, "The
+// predictor"). Dofs that share an equation (periodic partners) move together; massless ones
+// (rho_s = rho_f: quasi-static) start at x^n. Not when a contact slot is active at the start
+// (the contact force is the one part that changes sign within a step: a predicted node would be
+// driven into the surface that stopped it), not in a step with a prescribed increment (a motion
+// the trapezoidal step does not know of: the first solve applies it), nor when a term is not
+// finite (Newton's first residual then names the cause). The first iteration solves with the
+// matrix at x^n (modified Newton): the look-ahead's factor (factorize_ahead), or one made here,
+// so that a step's bits do not depend on whether the look-ahead ran (a resumed run's first step).
+void Solver::predict(double t1, double dt, const std::vector<std::vector<double>>* external) {
+  m_predictor_moved = false;
   keep_step_start();
   update_rigid(t1);
-  prepare_prescribed(t1);
+  const bool prescribed_increment = prepare_prescribed(t1);
+  remember_fronts();
+  if (m_model.settings.predictor != Predictor::acceleration || any_contact_active() ||
+      prescribed_increment)
+    return;
+  if (!m_ahead_fresh && !m_iteration_velocity && root_mass_tangent_lagged()) factorize_ahead(dt);
+  if (!factorize_mass()) return;
+  Eigen::VectorXd force = Eigen::VectorXd::Zero(m_neq), velocity = force;
+  std::vector<char> massive(m_neq, 0);
+  for (const auto& bp : m_bodies) {
+    const Body& B = *bp;
+    if (!B.is_elastic()) continue;
+    const std::vector<double>* fc = nullptr;
+    if (external && static_cast<int>(external->size()) > B.index &&
+        (*external)[B.index].size() == B.u.size())
+      fc = &(*external)[B.index];
+    for (std::size_t d = 0; d < B.u.size(); ++d) {
+      const int e = B.eq[d];
+      if (e < 0 || !(B.mass_row[d] > 0)) continue;
+      force[e] += B.ma[d] + (fc ? (*fc)[d] : 0.0) + B.contact[d];
+      velocity[e] = B.v_old[d];
+      massive[e] = 1;
+    }
+  }
+  if (!force.allFinite()) return;
+  const Eigen::VectorXd a = m_mass_solver.solve(force);
+  Eigen::VectorXd du = Eigen::VectorXd::Zero(m_neq);
+  for (int e = 0; e < m_neq; ++e)
+    if (massive[e]) du[e] = dt * velocity[e] + 0.5 * dt * dt * a[e];
+  if (!du.allFinite() || du.isZero(0.0)) return;
+  for (auto& bp : m_bodies) {
+    Body& B = *bp;
+    if (!B.is_elastic()) continue;
+    for (std::size_t d = 0; d < B.u.size(); ++d)
+      if (B.eq[d] >= 0) B.u[d] += du[B.eq[d]];
+    B.sync_positions();
+  }
+  m_predictor_moved = true;
+}
+
+// The mass matrix of the inertia (density rho_s - rho_f, as in the residual) on the free
+// equations, its lower triangle factorised once for the predictor. An equation without mass
+// (rho_s = rho_f) gets a unit diagonal and no force. False when it cannot be factorised.
+bool Solver::factorize_mass() {
+  if (m_mass_state != 0) return m_mass_state > 0;
+  std::vector<Eigen::Triplet<double>> entries;
+  std::vector<char> massive(m_neq, 0);
+  for (const auto& bp : m_bodies) {
+    const Body& B = *bp;
+    if (!B.is_elastic()) continue;
+    const Mesh& mesh = B.spec.mesh;
+    for (int el = 0; el < mesh.num_triangles(); ++el) {
+      const double rho = B.rho_inertia[el];
+      if (!(rho > 0)) continue;
+      const auto& t = mesh.triangles[el];
+      double me[3][3];
+      element_mass(B.geo[el].area, me);
+      for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 3; ++c)
+          for (int i = 0; i < 2; ++i) {
+            const int r = B.eq[2 * t[a] + i], q = B.eq[2 * t[c] + i];
+            if (r < 0 || q < 0 || q > r) continue;  // the lower triangle
+            entries.emplace_back(r, q, rho * me[a][c]);
+            massive[r] = massive[q] = 1;
+          }
+    }
+  }
+  for (int e = 0; e < m_neq; ++e)
+    if (!massive[e]) entries.emplace_back(e, e, 1.0);
+  Eigen::SparseMatrix<double> mass(m_neq, m_neq);
+  mass.setFromTriplets(entries.begin(), entries.end());
+  m_mass_solver.analyze(mass);
+  m_mass_state = m_mass_solver.factorize(mass) ? 1 : -1;
+  return m_mass_state > 0;
+}
+
+// Self-contact: what each node faces at the step's start, and where (contact.cpp).
+void Solver::remember_fronts() {
+  std::vector<const std::vector<double>*> xs;
+  for (const auto& b : m_bodies) xs.push_back(&b->x);
+  m_contact.remember_fronts(xs, contact_gap_tolerance());
 }
 
 // Newmark velocity from the positions, v^(n+1) = 2 (x^(n+1) - x^n) / dt - v^n (the trapezoidal

@@ -190,6 +190,10 @@ bool Solver::factorize_cached() {
     return true;
   }
   m_factored_valid = false;
+  // Not finite (overflowing constants): no factor, whatever the factorisation would return;
+  // factorize() names the cause.
+  for (std::size_t k = 0; k < nnz; ++k)
+    if (!std::isfinite(v[k])) return false;
   if (!m_linear.factorize(m_matrix)) return false;
   ++m_factorizations;
   m_factored.assign(v, v + nnz);

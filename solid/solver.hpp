@@ -235,7 +235,9 @@ class Solver {
   bool factorize_cached();
   // The Newmark step's parts (newmark.cpp).
   void initial_acceleration(double dt);
-  void predict(double t1);
+  void predict(double t1, double dt, const std::vector<std::vector<double>>* external);
+  void remember_fronts();
+  bool factorize_mass();
   StepReport newmark_span(double dt, const std::vector<std::vector<double>>* external,
                           const std::string& when, int cutbacks, int parts);
   StepReport newmark_step(double dt, const std::vector<std::vector<double>>* external,
@@ -288,6 +290,9 @@ class Solver {
   // factorize_ahead() factorised (or found factorised) this step's first matrix: the state the
   // step starts from, its c0, no active contact. Read and cleared by the step's newton().
   bool m_ahead_fresh = false;
+  bool m_predictor_moved = false;  // predict() moved an elastic node off x^n this step
+  LinearSolver m_mass_solver;      // the mass matrix on the free equations (factorize_mass)
+  int m_mass_state = 0;            // 0: not factorised yet, 1: factorised, -1: singular
   ContactSet m_contact;
   double m_contact_force_factor = 1;  // physical contact force / multiplier (1/2 in Newmark)
   bool m_dirichlet_pending = false;   // a prescribed increment awaits the first Newton solve

@@ -11,6 +11,7 @@ StepReport Solver::solve_static_step(double factor) {
   prepare_prescribed(factor);
   m_contact_force_factor = 1.0;  // without inertia the multiplier is the contact force
   keep_step_start();
+  remember_fronts();
   StepReport rep = newton(0, 0, factor, nullptr, when);
   check_finite(when);
   check_inverted(when);

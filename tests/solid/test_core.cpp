@@ -195,6 +195,40 @@ TEST_CASE("trapezoidal Newmark keeps the energy of a free linear-regime vibratio
   CHECK(s.strain_energy() > 0);
 }
 
+// The predictor (newmark.cpp, Solver::predict) is the trapezoidal step with the start's forces:
+// for a free body under gravity, a rigid translation with F - Q constant, it is the step itself,
+// so Newton's first residual meets the tolerance and no solve is made; starting at x^n, every
+// step solves. Either way the fall is the exact y = -g t^2 / 2 (trapezoidal rule, constant a).
+TEST_CASE("the predictor takes a free fall as the step: no Newton solve", "[newton]") {
+  for (Predictor predictor : {Predictor::none, Predictor::acceleration}) {
+    Model model;
+    model.settings.gravity = {0, -10};
+    model.settings.predictor = predictor;
+    BodySpec b;
+    b.name = "block";
+    b.mesh = rectangle_mesh(0, 0, 0.4, 0.2, 8, 4, Diagonals::criss_cross);
+    b.materials = {neo()};
+    model.bodies = {b};
+    Solver s(model);
+    const double dt = 1e-3;
+    const int steps = 20;
+    long solves = 0;
+    for (int k = 0; k < steps; ++k) solves += s.advance(dt).iterations;
+    const double t = steps * dt;
+    const std::vector<double> u = s.displacements(0);
+    double worst = 0;
+    for (std::size_t d = 0; d < u.size(); ++d)
+      worst = std::max(worst, std::abs(u[d] - (d % 2 ? -5.0 * t * t : 0.0)));
+    INFO("predictor " << (predictor == Predictor::acceleration ? "acceleration" : "none")
+                      << ", Newton solves " << solves << ", largest error " << worst);
+    CHECK(worst <= 1e-12);
+    if (predictor == Predictor::acceleration)
+      CHECK(solves == 0);
+    else
+      CHECK(solves >= steps);
+  }
+}
+
 TEST_CASE("a body with rho_s = rho_f has no FE mass and still solves quasi-statically", "[mass]") {
   Model model;
   model.settings.fluid_density = 2.0;  // equal to the solid density
