@@ -467,6 +467,10 @@ print("      solid round trip 2.31 -> 1.13 ms, 6.39 -> 4.99 ms per step")
 print("  the fluid's transforms along y as a vectorised matrix product where FFTW has only its")
 print("      generic O(n^2) code (101 rows at h = 0.01) | Poisson 1.4 -> 0.5 ms | the same segment:")
 print("      Poisson 1.42 -> 0.46 ms, 4.99 -> 3.87 ms per step (15.5 min for t = 12)")
+print("  tried, kept opt-in (solid.predictor = \"acceleration\"): Newton starts at the trapezoidal")
+print("      step with the start's forces, not at x^n | one iteration of two | h = 0, upwind3, 5000")
+print("      steps from rest, one run each: 1.98 -> 1.00 iterations, 4.36 -> 3.64 ms per step; to")
+print("      t = 12 the run stopped at t = 7.14 in contact (runs/vocal-folds/README.md), so off")
 PY
 }
 

@@ -219,13 +219,7 @@ void Solver::predict(double t1, double dt, const std::vector<std::vector<double>
   for (int e = 0; e < m_neq; ++e)
     if (massive[e]) du[e] = dt * velocity[e] + 0.5 * dt * dt * a[e];
   if (!du.allFinite() || du.isZero(0.0)) return;
-  for (auto& bp : m_bodies) {
-    Body& B = *bp;
-    if (!B.is_elastic()) continue;
-    for (std::size_t d = 0; d < B.u.size(); ++d)
-      if (B.eq[d] >= 0) B.u[d] += du[B.eq[d]];
-    B.sync_positions();
-  }
+  apply_newton_step(du);  // no prescribed increment is pending (above)
   m_predictor_moved = true;
 }
 
