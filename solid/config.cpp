@@ -289,7 +289,9 @@ Config read_config(const fsi::SceneTable& s, double fluid_density) {
   st.step_cutbacks = static_cast<int>(cutbacks);
   st.contact_tolerance = s.positive("contact_tolerance", defaults.contact_tolerance);
   st.keep_factor = s.boolean("keep_factor", defaults.keep_factor);
-  st.predictor = s.choice("predictor", {"none", "acceleration"}, "none") == "acceleration"
+  st.predictor = s.choice("predictor", {"none", "acceleration"},
+                          defaults.predictor == Predictor::acceleration ? "acceleration" : "none") ==
+                         "acceleration"
                      ? Predictor::acceleration
                      : Predictor::none;
   c.modes = static_cast<int>(s.integer("modes", 0));

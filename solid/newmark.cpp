@@ -170,10 +170,10 @@ void Solver::initial_acceleration(double dt) {
 // self-contact remembers what each node faces at x^n. Then, with settings.predictor =
 // "acceleration", the elastic bodies' free dofs with mass move to the trapezoidal step taken
 // with the forces of the step's start: in the residual (assembly.cpp) put
-// (F - Q)^(n+1) = (F - Q)^n = (M a)^n, keep this step's coupling force F_c and the last step's
-// contact force c^n (each enters twice: 2 F_c, B^T lambda = 2 c):
-//   (4/dt^2) M (x - x^n - dt v^n) = 2 ((M a)^n + F_c + c^n)
-//   x = x^n + dt v^n + (dt^2 / 2) M^-1 ((M a)^n + F_c + c^n),
+// (F - Q)^(n+1) = (F - Q)^n = (M a)^n and keep this step's coupling force F_c (it enters twice,
+// 2 F_c); no contact (no slot is active at the start):
+//   (4/dt^2) M (x - x^n - dt v^n) = 2 ((M a)^n + F_c)
+//   x = x^n + dt v^n + (dt^2 / 2) M^-1 ((M a)^n + F_c),
 // M the consistent mass on the free equations (factorize_mass; a lumped one leaves the rough
 // part of the fluid's force in the first residual). Newton's first residual is then the change
 // of F - Q over the step, not the step's whole inertia (4/dt) M v^n (solid/README.md, "The
@@ -181,18 +181,25 @@ void Solver::initial_acceleration(double dt) {
 // (rho_s = rho_f: quasi-static) start at x^n. Not when a contact slot is active at the start
 // (the contact force is the one part that changes sign within a step: a predicted node would be
 // driven into the surface that stopped it), not in a step with a prescribed increment (a motion
-// the trapezoidal step does not know of: the first solve applies it), nor when a term is not
-// finite (Newton's first residual then names the cause). The first iteration solves with the
-// matrix at x^n (modified Newton): the look-ahead's factor (factorize_ahead), or one made here,
-// so that a step's bits do not depend on whether the look-ahead ran (a resumed run's first step).
+// the trapezoidal step does not know of: the first solve applies it), not with fibers' root
+// masses (the step's mass there is M + m_root, which M^-1 leaves out), nor when a term is not
+// finite (Newton's first residual then names the cause). The coupled iterations' linearised
+// reaction is left out (it vanishes at a converged iteration). Where the look-ahead's factor
+// serves the step, the first iteration solves with the matrix at x^n (modified Newton), and a
+// step without a fresh look-ahead makes that factor here, so that its bits do not depend on
+// whether the look-ahead ran (a resumed run's first step).
 void Solver::predict(double t1, double dt, const std::vector<std::vector<double>>* external) {
   m_predictor_moved = false;
   keep_step_start();
   update_rigid(t1);
   const bool prescribed_increment = prepare_prescribed(t1);
   remember_fronts();
+  bool root_masses = false;
+  if (m_root_mass)
+    for (const auto& m : *m_root_mass)
+      for (double v : m) root_masses = root_masses || v != 0;
   if (m_model.settings.predictor != Predictor::acceleration || any_contact_active() ||
-      prescribed_increment)
+      prescribed_increment || root_masses)
     return;
   if (!m_ahead_fresh && !m_iteration_velocity && root_mass_tangent_lagged()) factorize_ahead(dt);
   if (!factorize_mass()) return;
@@ -208,7 +215,7 @@ void Solver::predict(double t1, double dt, const std::vector<std::vector<double>
     for (std::size_t d = 0; d < B.u.size(); ++d) {
       const int e = B.eq[d];
       if (e < 0 || !(B.mass_row[d] > 0)) continue;
-      force[e] += B.ma[d] + (fc ? (*fc)[d] : 0.0) + B.contact[d];
+      force[e] += B.ma[d] + (fc ? (*fc)[d] : 0.0);
       velocity[e] = B.v_old[d];
       massive[e] = 1;
     }
@@ -225,7 +232,8 @@ void Solver::predict(double t1, double dt, const std::vector<std::vector<double>
 
 // The mass matrix of the inertia (density rho_s - rho_f, as in the residual) on the free
 // equations, its lower triangle factorised once for the predictor. An equation without mass
-// (rho_s = rho_f) gets a unit diagonal and no force. False when it cannot be factorised.
+// (rho_s = rho_f) gets the mean diagonal of the others (no force: it does not move). False, with
+// a note, when it cannot be factorised.
 bool Solver::factorize_mass() {
   if (m_mass_state != 0) return m_mass_state > 0;
   std::vector<Eigen::Triplet<double>> entries;
@@ -250,12 +258,20 @@ bool Solver::factorize_mass() {
           }
     }
   }
+  double diagonal = 0;
+  int count = 0;
+  for (const auto& t : entries)
+    if (t.row() == t.col()) diagonal += t.value(), ++count;
+  const double placeholder = count > 0 ? diagonal / count : 1.0;
   for (int e = 0; e < m_neq; ++e)
-    if (!massive[e]) entries.emplace_back(e, e, 1.0);
+    if (!massive[e]) entries.emplace_back(e, e, placeholder);
   Eigen::SparseMatrix<double> mass(m_neq, m_neq);
   mass.setFromTriplets(entries.begin(), entries.end());
   m_mass_solver.analyze(mass);
   m_mass_state = m_mass_solver.factorize(mass) ? 1 : -1;
+  if (m_mass_state < 0)
+    std::fprintf(stderr, "[solid] note: the mass matrix is singular: solid.predictor = "
+                         "\"acceleration\" is off for this run\n");
   return m_mass_state > 0;
 }
 
