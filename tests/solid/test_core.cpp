@@ -195,20 +195,28 @@ TEST_CASE("trapezoidal Newmark keeps the energy of a free linear-regime vibratio
   CHECK(s.strain_energy() > 0);
 }
 
+namespace {
+// A 0.4 x 0.2 neo-Hookean block without supports or loads.
+Model free_block(Predictor predictor) {
+  Model model;
+  model.settings.predictor = predictor;
+  BodySpec b;
+  b.name = "block";
+  b.mesh = rectangle_mesh(0, 0, 0.4, 0.2, 8, 4, Diagonals::criss_cross);
+  b.materials = {neo()};
+  model.bodies = {b};
+  return model;
+}
+}  // namespace
+
 // The predictor (newmark.cpp, Solver::predict) is the trapezoidal step with the start's forces:
 // for a free body under gravity, a rigid translation with F - Q constant, it is the step itself,
 // so Newton's first residual meets the tolerance and no solve is made; starting at x^n, every
 // step solves. Either way the fall is the exact y = -g t^2 / 2 (trapezoidal rule, constant a).
 TEST_CASE("the predictor takes a free fall as the step: no Newton solve", "[newton]") {
   for (Predictor predictor : {Predictor::none, Predictor::acceleration}) {
-    Model model;
+    Model model = free_block(predictor);
     model.settings.gravity = {0, -10};
-    model.settings.predictor = predictor;
-    BodySpec b;
-    b.name = "block";
-    b.mesh = rectangle_mesh(0, 0, 0.4, 0.2, 8, 4, Diagonals::criss_cross);
-    b.materials = {neo()};
-    model.bodies = {b};
     Solver s(model);
     const double dt = 1e-3;
     const int steps = 20;
@@ -233,14 +241,7 @@ TEST_CASE("the predictor takes a free fall as the step: no Newton solve", "[newt
 // consistent mass's row sums times a uniform g') falls as under gravity g' (the force acts
 // over each step, entering the residual twice): with the predictor no solve, y = g' t^2 / 2.
 TEST_CASE("the predictor takes the coupling force's step: no Newton solve", "[newton]") {
-  Model model;
-  model.settings.predictor = Predictor::acceleration;
-  BodySpec b;
-  b.name = "block";
-  b.mesh = rectangle_mesh(0, 0, 0.4, 0.2, 8, 4, Diagonals::criss_cross);
-  b.materials = {neo()};
-  model.bodies = {b};
-  Solver s(model);
+  Solver s(free_block(Predictor::acceleration));
   const Mesh& mesh = s.mesh(0);
   const double g = -3.0, rho = neo().density;
   std::vector<std::vector<double>> f(1, std::vector<double>(2 * mesh.num_nodes(), 0.0));
