@@ -204,7 +204,6 @@ void Solver::predict(double t1, double dt, const std::vector<std::vector<double>
   if (!m_ahead_fresh && !m_iteration_velocity && root_mass_tangent_lagged()) factorize_ahead(dt);
   if (!factorize_mass()) return;
   Eigen::VectorXd force = Eigen::VectorXd::Zero(m_neq), velocity = force;
-  std::vector<char> massive(m_neq, 0);
   for (const auto& bp : m_bodies) {
     const Body& B = *bp;
     if (!B.is_elastic()) continue;
@@ -217,14 +216,11 @@ void Solver::predict(double t1, double dt, const std::vector<std::vector<double>
       if (e < 0 || !(B.mass_row[d] > 0)) continue;
       force[e] += B.ma[d] + (fc ? (*fc)[d] : 0.0);
       velocity[e] = B.v_old[d];
-      massive[e] = 1;
     }
   }
   if (!force.allFinite()) return;
-  const Eigen::VectorXd a = m_mass_solver.solve(force);
-  Eigen::VectorXd du = Eigen::VectorXd::Zero(m_neq);
-  for (int e = 0; e < m_neq; ++e)
-    if (massive[e]) du[e] = dt * velocity[e] + 0.5 * dt * dt * a[e];
+  // A massless equation has no velocity or force here and a decoupled row in M: it stays.
+  const Eigen::VectorXd du = dt * velocity + 0.5 * dt * dt * m_mass_solver.solve(force);
   if (!du.allFinite() || du.isZero(0.0)) return;
   apply_newton_step(du);  // no prescribed increment is pending (above)
   m_predictor_moved = true;
