@@ -174,10 +174,12 @@ Solver::ContactLinearisation Solver::linearise_contact(
 // Contact curvature: K_eff -= lambda d2g/dx2 (segment_gap_hessian) for every active slot on an
 // elastic segment. It couples the slave node to the master's nodes, entries the element pattern
 // lacks: the pattern grows once (re-analysed, re-assembled) the first time a pair of nodes meets.
-void Solver::add_contact_curvature(double c0, double dt, double time_or_factor,
-                                   const std::vector<std::vector<double>>* external) {
+// Without may_grow (the look-ahead) a missing entry leaves the matrix as it is and returns false.
+bool Solver::add_contact_curvature(double c0, double dt, double time_or_factor,
+                                   const std::vector<std::vector<double>>* external,
+                                   bool may_grow) {
   const auto& slots = m_contact.slots();
-  bool grow = false;
+  std::vector<std::pair<int, int>> missing;
   std::vector<std::array<int, 6>> slot_eqs;
   std::vector<int> slot_index;
   for (std::size_t k = 0; k < slots.size(); ++k) {
@@ -191,14 +193,13 @@ void Solver::add_contact_curvature(double c0, double dt, double time_or_factor,
                                  M.eq[2 * s.m1],         M.eq[2 * s.m1 + 1]};
     for (int a : eqs)
       for (int b : eqs)
-        if (a >= 0 && b >= 0 && a >= b && matrix_index(a, b) < 0) {
-          m_contact_entries.insert({a, b});
-          grow = true;
-        }
+        if (a >= 0 && b >= 0 && a >= b && matrix_index(a, b) < 0) missing.push_back({a, b});
     slot_eqs.push_back(eqs);
     slot_index.push_back(static_cast<int>(k));
   }
-  if (grow) {
+  if (!missing.empty()) {
+    if (!may_grow) return false;
+    m_contact_entries.insert(missing.begin(), missing.end());
     build_pattern();
     assemble(c0, dt, true, time_or_factor, external);
   }
@@ -217,6 +218,7 @@ void Solver::add_contact_curvature(double c0, double dt, double time_or_factor,
         if (eqs[r] >= 0 && eqs[c] >= 0 && eqs[r] >= eqs[c])
           values[matrix_index(eqs[r], eqs[c])] -= s.lambda * H[6 * r + c];
   }
+  return true;
 }
 
 // The active-set update of one iteration, through the factorised K_eff: given y0 = dx = K^-1 R,

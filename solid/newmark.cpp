@@ -27,17 +27,31 @@ void Solver::keep_step_start() {
   }
 }
 
+// The next step's first matrix, factorised while the fluid steps. Without active contact it is
+// K_eff(x^n), which iteration 0 then solves with unassembled (m_ahead_fresh). With active
+// contact iteration 0 assembles its matrix at x^n and adds the curvature of the slots active
+// after its detection; the slots as the last step left them (its converged iterate is x^n) are
+// those in most steps of a lasting contact, so their curvature is added here and the sum
+// factorised: factorize_cached() then finds iteration 0's matrix factorised when its values
+// agree bit for bit, and factorises it otherwise. Either way iteration 0 solves with the factor
+// of its own matrix, so a step's result does not depend on the look-ahead. Curvature that
+// would grow the pattern is left to the step (a pattern the step might not grow).
 void Solver::factorize_ahead(double dt) {
   m_ahead_fresh = false;
   if (m_bodies.empty() || m_neq == 0 || m_model.settings.analysis != Analysis::dynamic) return;
-  // Active contact adds its curvature to iteration 0's matrix after assembly: no match to hope for.
-  if (any_contact_active()) return;
+  const bool contact = any_contact_active();
   // The step starts with the factor it holds (newton.cpp, kKeepRatio): nothing to do ahead.
   if (m_keep_factor && m_factored_valid && m_contact.empty() && m_factored_c0 == newmark_c0(dt))
     return;
   keep_step_start();  // as advance() begins (the residual's inertia reads them)
   assemble(newmark_c0(dt), dt, true, m_time + dt, nullptr);
-  m_ahead_fresh = m_residual.allFinite() && factorize_cached();
+  if (!m_residual.allFinite()) return;
+  if (contact) {
+    if (add_contact_curvature(newmark_c0(dt), dt, m_time + dt, nullptr, false))
+      factorize_cached();
+    return;
+  }
+  m_ahead_fresh = factorize_cached();
 }
 
 // One step t^n -> t^(n+1) = t^n + dt:

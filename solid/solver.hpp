@@ -221,8 +221,9 @@ class Solver {
   double contact_gap_tolerance() const;
   ContactLinearisation linearise_contact(double c0, double dt, double time_or_factor,
                                          const std::vector<std::vector<double>>* external);
-  void add_contact_curvature(double c0, double dt, double time_or_factor,
-                             const std::vector<std::vector<double>>* external);
+  bool add_contact_curvature(double c0, double dt, double time_or_factor,
+                             const std::vector<std::vector<double>>* external,
+                             bool may_grow = true);
   void solve_contact(const ContactLinearisation& con, double gap_tol, Eigen::VectorXd& dx);
   void store_contact_forces();
   bool any_contact_active() const;
