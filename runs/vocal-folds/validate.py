@@ -29,7 +29,9 @@ contact between them.
   --restart RUN` resumes one; the outputs are unchanged). --convection upwind3: third-order
   upwind convection outside the sponge (fluid.convection; the blend --upwind then defaults to 0
   and the substeps' CFL number to 0.5, below AB2's limit for it), every output under
-  OUT/upwind3.
+  OUT/upwind3. --predictor: the solid's Newton starts each step without active contact at the
+  trapezoidal step taken with the forces of the step's start (solid.predictor = "acceleration";
+  solid/README.md), every output under OUT/predictor.
 With no option (`./fsi validate vocal-folds`): --modes, --short and --sweep."""
 import fcntl
 import json
@@ -84,6 +86,9 @@ P.add_argument("--cover-size", type=cli.positive, metavar="LC", default=None,
                     "(fold.geo's lc_cover; default: the element size lc = 0.024 throughout)")
 P.add_argument("--convection", choices=("central", "upwind3"), default="central",
                help="the fluid's convection outside the sponge (fluid.convection)")
+P.add_argument("--predictor", action="store_true",
+               help="the solid's Newton starts at the trapezoidal step of the step's start forces "
+                    "(solid.predictor = \"acceleration\")")
 P.add_argument("--checkpoint-interval", type=cli.positive, metavar="T", default=None,
                help="the coupled runs write a checkpoint every T")
 ARGS = P.parse_args()
@@ -99,7 +104,8 @@ for sub in (None if ARGS.material == "saint-venant-kirchhoff" else ARGS.material
             "planes" if ARGS.wall_planes else None,
             None if ARGS.substeps is None else f"substeps-{ARGS.substeps}",
             None if ARGS.cover_size is None else f"cover-{ARGS.cover_size:g}",
-            "upwind3" if UPWIND3 else None):
+            "upwind3" if UPWIND3 else None,
+            "predictor" if ARGS.predictor else None):
     if sub:
         OUT = job.OUT = os.path.join(OUT, sub)
         os.makedirs(OUT, exist_ok=True)
@@ -174,6 +180,8 @@ bodies = ["upper"]
         text = "\n".join(lines) + "\n"
     if modes:
         text = text.replace("newton_max_iterations = 30", f"newton_max_iterations = 30\nmodes = {modes}")
+    if ARGS.predictor and fluid:
+        text = text.replace("newton_max_iterations = 30", 'newton_max_iterations = 30\npredictor = "acceleration"')
     return text
 
 
