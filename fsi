@@ -476,7 +476,7 @@ print("      factorised while the fluid steps; iteration 0 finds it when the val
 print("      bit | one factorisation per contact step off the critical path | h = 0, upwind3,")
 print("      predictor, 2000 steps from t = 7, two pairs alternately: solid round trip 3.17, 3.43")
 print("      -> 2.73, 2.77 ms; 7.49, 7.72 -> 7.07, 7.22 ms per step; the same bits")
-print("  -march=native (FSI_NATIVE) | the stencil loops vectorised 4 or 8 wide | the same")
+print("  -march=native (FSI_NATIVE) | the stencil loops vectorised with AVX2 | the same")
 print("      segment, portable and native alternately: the fluid's predictor phase 4.90, 4.79 ->")
 print("      3.94, 4.28 s; the whole step 8.42, 7.88 -> 8.15, 8.54 ms (within the machine's noise)")
 PY

@@ -186,6 +186,11 @@ bool Solver::factorize_cached() {
   const auto nnz = static_cast<std::size_t>(m_matrix.nonZeros());
   if (m_factored_valid && m_factored.size() == nnz &&
       std::memcmp(v, m_factored.data(), nnz * sizeof(double)) == 0) {
+    // The factor is that of this matrix: it takes this matrix's flags (a look-ahead's matrix
+    // marked curved whose curvature added nothing equals a plain one), as a fresh factorisation
+    // of the same values would.
+    m_factored_c0 = m_matrix_c0;
+    m_factored_curved = m_matrix_curved;
     ++m_factor_reuses;
     return true;
   }
