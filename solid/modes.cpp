@@ -53,6 +53,25 @@ class ShiftInvertOp {
 
 }  // namespace
 
+// M += the consistent mass of the inertial density rho_s - rho_f of every element that has one,
+// on the values of M, a matrix of m_matrix's pattern (its lower triangle).
+void Solver::add_mass(Eigen::SparseMatrix<double>& M) const {
+  for (const auto& bp : m_bodies) {
+    const Body& B = *bp;
+    if (!B.is_elastic()) continue;
+    for (int e = 0; e < B.spec.mesh.num_triangles(); ++e) {
+      const double rho = B.rho_inertia[e];
+      if (!(rho > 0)) continue;
+      double me[3][3];
+      element_mass(B.geo[e].area, me);
+      const auto& map = B.kmap[e];
+      for (int r = 0; r < 6; ++r)
+        for (int c = r % 2; c < 6; c += 2)
+          if (map[6 * r + c] >= 0) M.valuePtr()[map[6 * r + c]] += rho * me[r / 2][c / 2];
+    }
+  }
+}
+
 Modes Solver::modes(int count, double shift) const {
   if (count < 1) fsi::fail("modes: need at least one mode, got {}", count);
   Eigen::SparseMatrix<double> K = m_matrix, M = m_matrix;
@@ -70,18 +89,12 @@ Modes Solver::modes(int count, double shift) const {
             B.spec.name, e, B.rho_inertia[e]);
       double fe[6], ke[36], J;
       element_internal(B.spec.materials[B.material[e]], B.geo[e], zero, zero, zero, fe, ke, &J);
-      double me[3][3];
-      element_mass(B.geo[e].area, me);
       const auto& map = B.kmap[e];
-      for (int r = 0; r < 6; ++r)
-        for (int c = 0; c < 6; ++c) {
-          const int k = map[6 * r + c];
-          if (k < 0) continue;
-          K.valuePtr()[k] += ke[6 * r + c];
-          if (r % 2 == c % 2) M.valuePtr()[k] += B.rho_inertia[e] * me[r / 2][c / 2];
-        }
+      for (int k = 0; k < 36; ++k)
+        if (map[k] >= 0) K.valuePtr()[map[k]] += ke[k];
     }
   }
+  add_mass(M);
   const int n = m_neq;
   const int nev = std::min(count, n - 1);
   const int ncv = std::min(n, std::max(2 * nev + 1, nev + kLanczosExtraVectors));

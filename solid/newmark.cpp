@@ -247,37 +247,16 @@ void Solver::predict(double t1, double dt, const std::vector<std::vector<double>
 // a note, when it cannot be factorised.
 bool Solver::factorize_mass() {
   if (m_mass_state != 0) return m_mass_state > 0;
-  std::vector<Eigen::Triplet<double>> entries;
-  std::vector<char> massive(m_neq, 0);
-  for (const auto& bp : m_bodies) {
-    const Body& B = *bp;
-    if (!B.is_elastic()) continue;
-    const Mesh& mesh = B.spec.mesh;
-    for (int el = 0; el < mesh.num_triangles(); ++el) {
-      const double rho = B.rho_inertia[el];
-      if (!(rho > 0)) continue;
-      const auto& t = mesh.triangles[el];
-      double me[3][3];
-      element_mass(B.geo[el].area, me);
-      for (int a = 0; a < 3; ++a)
-        for (int c = 0; c < 3; ++c)
-          for (int i = 0; i < 2; ++i) {
-            const int r = B.eq[2 * t[a] + i], q = B.eq[2 * t[c] + i];
-            if (r < 0 || q < 0 || q > r) continue;  // the lower triangle
-            entries.emplace_back(r, q, rho * me[a][c]);
-            massive[r] = massive[q] = 1;
-          }
-    }
-  }
+  Eigen::SparseMatrix<double> mass = m_matrix;
+  std::fill_n(mass.valuePtr(), mass.nonZeros(), 0.0);
+  add_mass(mass);
   double diagonal = 0;
   int count = 0;
-  for (const auto& t : entries)
-    if (t.row() == t.col()) diagonal += t.value(), ++count;
+  for (int e = 0; e < m_neq; ++e)
+    if (const double d = mass.valuePtr()[matrix_index(e, e)]; d > 0) diagonal += d, ++count;
   const double placeholder = count > 0 ? diagonal / count : 1.0;
   for (int e = 0; e < m_neq; ++e)
-    if (!massive[e]) entries.emplace_back(e, e, placeholder);
-  Eigen::SparseMatrix<double> mass(m_neq, m_neq);
-  mass.setFromTriplets(entries.begin(), entries.end());
+    if (double& d = mass.valuePtr()[matrix_index(e, e)]; !(d > 0)) d = placeholder;
   m_mass_solver.analyze(mass);
   m_mass_state = m_mass_solver.factorize(mass) ? 1 : -1;
   if (m_mass_state < 0)

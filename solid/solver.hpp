@@ -239,6 +239,7 @@ class Solver {
   void predict(double t1, double dt, const std::vector<std::vector<double>>* external);
   void remember_fronts();
   bool factorize_mass();
+  void add_mass(Eigen::SparseMatrix<double>& M) const;
   StepReport newmark_span(double dt, const std::vector<std::vector<double>>* external,
                           const std::string& when, int cutbacks, int parts);
   StepReport newmark_step(double dt, const std::vector<std::vector<double>>* external,
