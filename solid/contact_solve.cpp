@@ -119,9 +119,12 @@ double Solver::contact_gap_tolerance() const {
 // (lambda > 0) or within reach (gap below one element edge of the slave) become the candidates
 // of this iteration's complementarity problem, each with its row of B = dg/dx on the free
 // equations. A pending prescribed increment moves a gap by its own part, B_p du_p. The residual
-// becomes R + B^T lambda of the active slots.
+// becomes R + B^T lambda of the active slots. `with_curvature`: the iteration assembled its
+// matrix, which then takes the active slots' curvature (an iteration that solves with an
+// earlier factor has no matrix of its own to add it to).
 Solver::ContactLinearisation Solver::linearise_contact(
-    double c0, double dt, double time_or_factor, const std::vector<std::vector<double>>* external) {
+    double c0, double dt, double time_or_factor, const std::vector<std::vector<double>>* external,
+    bool with_curvature) {
   ContactLinearisation con;
   con.residual = m_residual;
   if (m_contact.empty()) return con;
@@ -167,7 +170,7 @@ Solver::ContactLinearisation Solver::linearise_contact(
     if (s.active)
       for (const auto& [e, w] : con.rows[k]) con.residual[e] += s.lambda * w;
   }
-  if (con.active > 0) add_contact_curvature(c0, dt, time_or_factor, external);
+  if (con.active > 0 && with_curvature) add_contact_curvature(c0, dt, time_or_factor, external);
   return con;
 }
 

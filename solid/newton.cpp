@@ -29,11 +29,12 @@ constexpr int kContactsNamed = 8;
 // Residuals of the last iterations a failed step shows.
 constexpr std::size_t kResidualsNamed = 5;
 // A later iteration of a step solves with the factor of an earlier one (modified Newton) while
-// the residual falls by at least this factor per iteration and neither that factor's matrix nor
-// this iteration's holds contact curvature (an active slot's; open candidates add rows to the
-// complementarity problem, not to the matrix): the tangent then changes too little within the
-// step to matter (a step of a body whose inertia term 4M/dt^2 dominates its stiffness); a
-// slower fall factorises the current tangent.
+// the residual falls by at least this factor per iteration: the tangent then changes too little
+// within the step to matter (a step of a body whose inertia term 4M/dt^2 dominates its
+// stiffness); a slower fall factorises the current tangent. In contact too: the contact
+// conditions are linearised afresh in every iteration (the gaps, B, the complementarity problem
+// through the held factor), so only the tangent is an earlier one, its contact curvature that of
+// the slots active when it was factorised; the contraction test covers both.
 constexpr double kReuseRatio = 1e-2;
 // A dynamic step starts with the factor the last step solved with (kept across steps) when that
 // step's first solve cut the residual by at least this factor: the matrix of a body whose
@@ -80,18 +81,18 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
   for (int it = 0;; ++it) {
     auto t0 = clock::now();
     m_tangent_root_mass_now = it > 0;  // add_root_mass: the first tangent takes the last step's
-    // The held factor serves this iteration (modified Newton) when it is valid, neither its
-    // matrix nor this iteration's has contact curvature (no slot active: detection releases
-    // slots, only the complementarity problem activates them), no prescribed increment needs the
-    // matrix in the residual, and either this is a later iteration (kept while it contracts
-    // fast, below), or a dynamic step's first iteration with the look-ahead's factor of this
-    // very matrix, or one after a step whose first solve contracted by kKeepRatio. Such an
-    // iteration assembles the residual only; if the contraction then says "factorise", the
-    // matrix is assembled at the same iterate.
+    // The held factor serves this iteration (modified Newton) when it is valid, no prescribed
+    // increment needs the matrix in the residual, and either this is a later iteration (kept
+    // while it contracts fast, below, with or without contact), or a dynamic step's first
+    // iteration without contact curvature in the factor's matrix or in this one (no slot active:
+    // detection releases slots, only the complementarity problem activates them) with the
+    // look-ahead's factor of this very matrix, or one after a step whose first solve contracted
+    // by kKeepRatio. Such an iteration assembles the residual only; if the contraction then says
+    // "factorise", the matrix and its contact curvature are assembled at the same iterate.
     const bool plain_factor = m_factored_valid && !m_factored_curved && !any_contact_active();
     const bool may_reuse =
-        plain_factor && !m_dirichlet_pending &&
-        (it > 0 || (m_factored_c0 == c0 &&
+        m_factored_valid && !m_dirichlet_pending &&
+        (it > 0 || (plain_factor && m_factored_c0 == c0 &&
                     (ahead || (m_keep_allowed && m_keep_factor && m_contact.empty()))));
     assemble_iterate(c0, dt, time_or_factor, external, it > 0, dx, when, !may_reuse);
     rep.assembly_seconds += seconds_since(t0);
@@ -99,7 +100,8 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
     if (it == 0 && may_reuse && ahead && !m_predictor_moved)
       check_ahead_matrix(c0, dt, time_or_factor, external);
 #endif
-    const ContactLinearisation contact = linearise_contact(c0, dt, time_or_factor, external);
+    const ContactLinearisation contact =
+        linearise_contact(c0, dt, time_or_factor, external, !may_reuse);
 
     const double rn = contact.residual.norm();
     rep.residuals.push_back(rn);
@@ -111,12 +113,13 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
       break;
     }
     if (it >= st.newton_max_iterations) break;
-    // may_reuse had no slot active, and detection activates none: no curvature was added.
-    FSI_ASSERT(!may_reuse || contact.active == 0);
+    // A first iteration that may reuse had no slot active, and detection activates none.
+    FSI_ASSERT(!may_reuse || it > 0 || contact.active == 0);
     const bool reuse = may_reuse && (it == 0 || rn <= kReuseRatio * previous);
     if (!reuse && may_reuse) {
       t0 = clock::now();
       assemble(c0, dt, true, time_or_factor, external);
+      if (contact.active > 0) add_contact_curvature(c0, dt, time_or_factor, external);
       rep.assembly_seconds += seconds_since(t0);
     }
     previous = rn;

@@ -220,7 +220,8 @@ class Solver {
   struct ContactLinearisation;
   double contact_gap_tolerance() const;
   ContactLinearisation linearise_contact(double c0, double dt, double time_or_factor,
-                                         const std::vector<std::vector<double>>* external);
+                                         const std::vector<std::vector<double>>* external,
+                                         bool with_curvature);
   bool add_contact_curvature(double c0, double dt, double time_or_factor,
                              const std::vector<std::vector<double>>* external,
                              bool may_grow = true);
