@@ -91,7 +91,7 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
       double fe[6], ke[36];
       double J = 1;
       element_internal(B.spec.materials[B.material[e]], B.geo[e], &B.u[2 * t[0]], &B.u[2 * t[1]],
-                       &B.u[2 * t[2]], fe, with_matrix ? ke : nullptr, &J);
+                       &B.u[2 * t[2]], fe, with_matrix ? ke : nullptr, &J, false);
       B.det_f[e] = J;
       if (!(J > 0) && inverted.first < 0) inverted = {B.index, e};
       for (int a = 0; a < 3; ++a)

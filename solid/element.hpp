@@ -46,17 +46,17 @@ inline Eigen::Matrix2d displacement_gradient(const ElementGeometry& g, const dou
 //   K_ai,bj = A0 [ (B^T D B)_ai,bj + delta_ij dN_a/dX_J S_JK dN_b/dX_K ],
 // with the Green-Lagrange variation rows B = dE/dx:
 //   dE11 = F_i1 dN_a/dX1,  dE22 = F_i2 dN_a/dX2,  2 dE12 = F_i1 dN_a/dX2 + F_i2 dN_a/dX1.
-// u0, u1, u2 are the nodal displacements. Returns the strain energy A0 W; `ke` (row-major 6x6)
-// may be null. `det_f` receives det F.
+// u0, u1, u2 are the nodal displacements. Returns the strain energy A0 W (NaN without
+// `with_energy`, evaluate_material); `ke` (row-major 6x6) may be null. `det_f` receives det F.
 inline double element_internal(const Material& m, const ElementGeometry& g, const double* u0,
                                const double* u1, const double* u2, double fe[6], double* ke,
-                               double* det_f) {
+                               double* det_f, bool with_energy = true) {
   const Eigen::Matrix2d H = displacement_gradient(g, u0, u1, u2);
   const Eigen::Matrix2d F = Eigen::Matrix2d::Identity() + H;
   *det_f = F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0);
   Eigen::Vector3d S;
   Eigen::Matrix3d D;
-  const double W = evaluate_material(m, H, &S, ke ? &D : nullptr);
+  const double W = evaluate_material(m, H, &S, ke ? &D : nullptr, with_energy);
   double B[3][6];
   for (int a = 0; a < 3; ++a) {
     const double d1 = g.dn[a][0], d2 = g.dn[a][1];

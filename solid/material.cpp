@@ -67,7 +67,7 @@ double svk(const Material& m, const Eigen::Matrix2d& H, Eigen::Vector3d* S, Eige
 }
 
 double neo_hookean(const Material& m, const Eigen::Matrix2d& H, Eigen::Vector3d* S,
-                   Eigen::Matrix3d* D) {
+                   Eigen::Matrix3d* D, bool with_energy) {
   const double J = 1 + H.trace() + H.determinant();
   if (!(J > 0)) {
     if (S) S->setConstant(std::numeric_limits<double>::quiet_NaN());
@@ -76,12 +76,16 @@ double neo_hookean(const Material& m, const Eigen::Matrix2d& H, Eigen::Vector3d*
   }
   const Eigen::Matrix2d C = Eigen::Matrix2d::Identity() + 2 * green_lagrange(H);
   const double I1 = C.trace() + 1;
-  const double Jm23 = std::pow(J, -2.0 / 3.0);
+  const double cbrt_j = std::cbrt(J);
+  const double Jm23 = 1 / (cbrt_j * cbrt_j);
   // J^(-2/3) I1 - 3 and J - 1 evaluated without cancellation near the reference state.
-  const double tr_e2 = 2 * green_lagrange(H).trace();              // I1 - 3
-  const double jm1 = H.trace() + H.determinant();                  // J - 1
-  const double jm23m1 = std::expm1(-2.0 / 3.0 * std::log1p(jm1));  // J^(-2/3) - 1
-  const double W = 0.5 * m.mu * (jm23m1 * I1 + tr_e2) + 0.5 * m.bulk * jm1 * jm1;
+  const double tr_e2 = 2 * green_lagrange(H).trace();  // I1 - 3
+  const double jm1 = H.trace() + H.determinant();      // J - 1
+  double W = std::numeric_limits<double>::quiet_NaN();
+  if (with_energy) {
+    const double jm23m1 = std::expm1(-2.0 / 3.0 * std::log1p(jm1));  // J^(-2/3) - 1
+    W = 0.5 * m.mu * (jm23m1 * I1 + tr_e2) + 0.5 * m.bulk * jm1 * jm1;
+  }
   const double detC = J * J;
   Eigen::Matrix2d Ci;
   Ci << C(1, 1) / detC, -C(0, 1) / detC, -C(1, 0) / detC, C(0, 0) / detC;
@@ -122,8 +126,9 @@ double neo_hookean(const Material& m, const Eigen::Matrix2d& H, Eigen::Vector3d*
 }  // namespace
 
 double evaluate_material(const Material& m, const Eigen::Matrix2d& H, Eigen::Vector3d* S,
-                         Eigen::Matrix3d* D) {
-  return m.model == MaterialModel::neo_hookean ? neo_hookean(m, H, S, D) : svk(m, H, S, D);
+                         Eigen::Matrix3d* D, bool with_energy) {
+  return m.model == MaterialModel::neo_hookean ? neo_hookean(m, H, S, D, with_energy)
+                                               : svk(m, H, S, D);
 }
 
 Eigen::Vector4d cauchy_stress(const Material& m, const Eigen::Matrix2d& H) {

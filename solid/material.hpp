@@ -38,9 +38,11 @@ std::string material_model_name(MaterialModel model);
 // (Eq. 7 prints "tr C^ - 2"; with C33 = 1 the unstressed reference needs the 3D form above.)
 // H = F - I is the 2x2 in-plane displacement gradient (E = (H + H^T + H^T H) / 2 without the
 // cancellation of F^T F - I at small strain). Returns W per unit reference volume; S and D are
-// written when the pointers are non-null. J <= 0 gives a NaN energy for neo-Hookean.
+// written when the pointers are non-null. J <= 0 gives a NaN energy for neo-Hookean. Without
+// `with_energy` W is not evaluated (the assembly needs S and D only; the neo-Hookean energy
+// takes two transcendental functions of its own) and NaN is returned.
 double evaluate_material(const Material& m, const Eigen::Matrix2d& H, Eigen::Vector3d* S,
-                         Eigen::Matrix3d* D);
+                         Eigen::Matrix3d* D, bool with_energy = true);
 
 // Cauchy stress (11, 22, 12, 33) from H = F - I: sigma = F S F^T / J, sigma33 = S33 / J with
 // the out-of-plane S33 that plane strain implies.
