@@ -45,6 +45,13 @@ double segment_distance(double px, double py, double ax, double ay, double bx, d
   return std::hypot(ax + xi * ex - px, ay + xi * ey - py);
 }
 
+// The bin of coordinate v on n bins of 1/inv from origin, the outer bins extended to infinity
+// (clamped as a double: a far coordinate would overflow an int).
+int bin_of(double v, double origin, double inv, int n) {
+  const double t = (v - origin) * inv;
+  return t < 1 ? 0 : t >= n - 1 ? n - 1 : static_cast<int>(t);
+}
+
 }  // namespace
 
 bool inside_surface(const Mesh& mesh, const std::vector<double>& x, double px, double py) {
@@ -193,8 +200,70 @@ void ContactSet::detect(const std::vector<const std::vector<double>*>& x,
       box[3] = std::max(box[3], (*x[b])[2 * n + 1]);
     }
   }
+  m_self_bins.resize(m_surfaces.size());
+  for (std::size_t b = 0; b < m_self_slot.size(); ++b)
+    if (!m_self_slot[b].empty())
+      bin_edges(m_surfaces[b], *x[b], kSelfSearch * reach[b], m_self_bins[b]);
   for (auto& s : m_slots) detect_slot(s, x, boxes, reach[s.slave_body]);
   join_vertex_pairs(x);
+}
+
+// Bins of about the search distance (at most kMaxBins along a side), each edge entered in every
+// bin its widened box [min - search, max + search] meets: a point inside that box lies in one
+// of those bins. Edges with a position that is not finite are entered in every bin.
+void ContactSet::bin_edges(const Surface& surf, const std::vector<double>& x, double search,
+                           EdgeBins& bins) const {
+  constexpr int kMaxBins = 64;
+  const auto& edges = surf.mesh->surface;
+  double lo[2] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max()};
+  double hi[2] = {-std::numeric_limits<double>::max(), -std::numeric_limits<double>::max()};
+  for (int n : surf.nodes)
+    for (int c = 0; c < 2; ++c) {
+      lo[c] = std::min(lo[c], x[2 * n + c]);
+      hi[c] = std::max(hi[c], x[2 * n + c]);
+    }
+  const double w = std::max(hi[0] - lo[0], hi[1] - lo[1]) + 2 * search;
+  if (!(std::isfinite(w) && search > 0)) {
+    // One bin holding every edge, outside which no point is looked up (inv = 0: every point
+    // falls in bin 0).
+    bins = {0, 0, 0, 1, 1, {0, static_cast<int>(edges.size())}, {}};
+    for (int k = 0; k < static_cast<int>(edges.size()); ++k) bins.edges.push_back(k);
+    return;
+  }
+  const double size = std::max(search, w / kMaxBins);
+  bins.x0 = lo[0] - search;
+  bins.y0 = lo[1] - search;
+  bins.inv = 1 / size;
+  bins.nx = std::min(kMaxBins, static_cast<int>((hi[0] - lo[0] + 2 * search) * bins.inv) + 1);
+  bins.ny = std::min(kMaxBins, static_cast<int>((hi[1] - lo[1] + 2 * search) * bins.inv) + 1);
+  auto cell = [&](double v, double origin, int n) { return bin_of(v, origin, bins.inv, n); };
+  auto range = [&](int k, int r[4]) {
+    const auto& e = edges[k];
+    const double ax = x[2 * e[0]], ay = x[2 * e[0] + 1], bx = x[2 * e[1]], by = x[2 * e[1] + 1];
+    if (!(std::isfinite(ax) && std::isfinite(ay) && std::isfinite(bx) && std::isfinite(by))) {
+      r[0] = 0, r[1] = bins.nx - 1, r[2] = 0, r[3] = bins.ny - 1;
+      return;
+    }
+    r[0] = cell(std::min(ax, bx) - search, bins.x0, bins.nx);
+    r[1] = cell(std::max(ax, bx) + search, bins.x0, bins.nx);
+    r[2] = cell(std::min(ay, by) - search, bins.y0, bins.ny);
+    r[3] = cell(std::max(ay, by) + search, bins.y0, bins.ny);
+  };
+  bins.start.assign(static_cast<std::size_t>(bins.nx * bins.ny + 1), 0);
+  int r[4];
+  for (int k = 0; k < static_cast<int>(edges.size()); ++k) {
+    range(k, r);
+    for (int j = r[2]; j <= r[3]; ++j)
+      for (int i = r[0]; i <= r[1]; ++i) ++bins.start[i + bins.nx * j + 1];
+  }
+  for (std::size_t c = 1; c < bins.start.size(); ++c) bins.start[c] += bins.start[c - 1];
+  bins.edges.resize(static_cast<std::size_t>(bins.start.back()));
+  std::vector<int> fill(bins.start.begin(), bins.start.end() - 1);
+  for (int k = 0; k < static_cast<int>(edges.size()); ++k) {
+    range(k, r);
+    for (int j = r[2]; j <= r[3]; ++j)
+      for (int i = r[0]; i <= r[1]; ++i) bins.edges[fill[i + bins.nx * j]++] = k;
+  }
 }
 
 // Two nodes a and b of one surface, each at the other's vertex (a curled fold's two shoulders
@@ -254,7 +323,8 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
     return;
   }
   if (s.master_body == s.slave_body)
-    return detect_self(s, m_front[&s - m_slots.data()], *x[s.slave_body], reach);
+    return detect_self(s, m_front[&s - m_slots.data()], *x[s.slave_body], reach,
+                       m_self_bins[s.slave_body]);
   const auto& box = boxes[s.master_body];
   const double dx = std::max({box[0] - px, 0.0, px - box[2]});
   const double dy = std::max({box[1] - py, 0.0, py - box[3]});
@@ -380,7 +450,8 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
 // The closest remaining feature wins, with detect_slot's rules: ties prefer the edge whose
 // interior holds the projection, and the last edge extended by kKeepEdge is kept.
 void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
-                             const std::vector<double>& x, double reach) const {
+                             const std::vector<double>& x, double reach,
+                             const EdgeBins& bins) const {
   const Surface& surf = m_surfaces[s.slave_body];
   const Mesh& mesh = *surf.mesh;
   const double px = x[2 * s.slave_node], py = x[2 * s.slave_node + 1];
@@ -469,12 +540,31 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
   const std::vector<double>& start = m_start.size() > static_cast<std::size_t>(s.slave_body)
                                          ? m_start[s.slave_body]
                                          : kNoPositions;
-  std::size_t skip = 0;
-  for (int k = 0; k < static_cast<int>(mesh.surface.size()); ++k) {
-    if (skip < near.size() && near[skip] == k) {
-      ++skip;
-      continue;
+  // The edges to examine, in edge order: those of the node's bin (bin_edges: every edge whose
+  // box widened by `search` may hold the node) and the guarded ones (the edges at a guard node).
+  thread_local std::vector<int> examine;
+  examine.clear();
+  {
+    if (std::isfinite(px) && std::isfinite(py)) {
+      const int c = bin_of(px, bins.x0, bins.inv, bins.nx) +
+                    bins.nx * bin_of(py, bins.y0, bins.inv, bins.ny);
+      examine.assign(bins.edges.begin() + bins.start[c], bins.edges.begin() + bins.start[c + 1]);
+    } else {
+      for (int k = 0; k < static_cast<int>(mesh.surface.size()); ++k) examine.push_back(k);
     }
+    const std::size_t binned = examine.size();
+    for (int g : guard)
+      if (g >= 0)
+        for (int k : surf.vertex_edges[g]) examine.push_back(k);
+    if (examine.size() > binned) {
+      std::sort(examine.begin(), examine.end());
+      examine.erase(std::unique(examine.begin(), examine.end()), examine.end());
+    }
+  }
+  std::size_t skip = 0;
+  for (const int k : examine) {
+    while (skip < near.size() && near[skip] < k) ++skip;
+    if (skip < near.size() && near[skip] == k) continue;
     const auto& e = mesh.surface[k];
     const bool guard_edge = guarded(e);
     // Farther than `search` along x or y from the edge's box: not a feature (unless guarded).

@@ -69,10 +69,21 @@ class ContactSet {
     std::vector<std::vector<int>> vertex_edges;
   };
   void setup_self(Surface& s) const;
+  // Self-contact's broad phase: the surface edges of one body binned on a uniform grid over
+  // their boxes widened by the search distance, so that the edges whose widened box holds a
+  // point are the edges of the point's bin (each bin's list in edge order). Rebuilt at each
+  // detection.
+  struct EdgeBins {
+    double x0 = 0, y0 = 0, inv = 0;  // grid origin, 1 / bin size
+    int nx = 0, ny = 0;
+    std::vector<int> start, edges;  // bin (i, j)'s edges: edges[start[i + nx j] ...]
+  };
+  void bin_edges(const Surface& surf, const std::vector<double>& x, double search,
+                 EdgeBins& bins) const;
   void detect_slot(ContactSlot& s, const std::vector<const std::vector<double>*>& x,
                    const std::vector<std::array<double, 4>>& boxes, double reach) const;
   void detect_self(ContactSlot& s, const std::array<int, 2>& front, const std::vector<double>& x,
-                   double reach) const;
+                   double reach, const EdgeBins& bins) const;
   void join_vertex_pairs(const std::vector<const std::vector<double>*>& x);
   std::vector<Surface> m_surfaces;
   std::vector<ContactPlane> m_planes;
@@ -81,6 +92,7 @@ class ContactSet {
   std::vector<std::vector<double>> m_start;  // per body (self-contact), remember_fronts
   double m_gap_tol = 0;                       // remember_fronts
   std::vector<std::vector<int>> m_self_slot;  // per body, per node: its self-contact slot or -1
+  std::vector<EdgeBins> m_self_bins;          // per body (self-contact), detect
 };
 
 // Second derivative of the gap to a segment, g = (x_s - x_1) . n with n = (e_y, -e_x) / l,
