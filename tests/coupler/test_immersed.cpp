@@ -1,6 +1,7 @@
 // The immersed solid transfers: volume fractions add up to the body's area, mean velocities are
 // the exact means of linear fields, and the nodal reaction cancels the fluid forcing.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -8,6 +9,7 @@
 #include "clip.hpp"
 #include "fixtures.hpp"
 #include "immersed.hpp"
+#include "sorted_marks.hpp"
 
 using namespace coupler;
 using coupler::testing::grid;
@@ -625,5 +627,30 @@ TEST_CASE("smoothed footprint: the mean velocity of a linear field and action = 
     const auto bal = action_plus_reaction(g, is, u, v, rng);
     CHECK(std::abs(bal.fx) <= 1e-12 * bal.scale);
     CHECK(std::abs(bal.fy) <= 1e-12 * bal.scale);
+  }
+}
+
+// The faces a footprint touches are listed in index order whatever their spread: a band read off
+// the marks, or a radix sort when the marks are far apart (two bodies on opposite walls).
+TEST_CASE("sort_marked lists the marked faces in order, dense or spread", "[immersed]") {
+  std::mt19937 rng(7);
+  for (const int range : {50, 3000, 70000, 5000000}) {
+    for (const int count : {1, 40, 2000}) {
+      if (count > range) continue;
+      std::vector<char> mark(static_cast<std::size_t>(range), 0);
+      std::vector<std::int32_t> list;
+      const std::int32_t lo = 17;
+      std::uniform_int_distribution<std::int32_t> pick(0, range - 1);
+      while (static_cast<int>(list.size()) < count) {
+        const std::int32_t k = pick(rng);
+        if (!mark[k]) mark[k] = 1, list.push_back(lo + k);
+      }
+      std::vector<std::int32_t> expected = list;
+      std::sort(expected.begin(), expected.end());
+      const std::int32_t hi = expected.back();
+      sort_marked(list, expected.front(), hi, [&](std::int32_t k) { return mark[k - lo] != 0; });
+      INFO("range " << range << ", " << count << " marks");
+      CHECK(list == expected);
+    }
   }
 }
