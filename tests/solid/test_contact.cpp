@@ -547,6 +547,43 @@ TEST_CASE("self-contact: two nodes at each other's vertex are one contact",
 }
 
 
+// A node in a vertex's zone and behind it by more than twice its motion since the step's start
+// (here: it has not moved) is at that vertex, not at the body's other side, when the last
+// detection had it there: the crossing bound drops a fresh find only. (A creased vocal fold's
+// two nodes pressed onto each other were taken and dropped by turns as the bound changed from
+// one Newton iteration to the next, and Newton cycled.)
+TEST_CASE("self-contact: a node kept in a vertex's zone is not taken for the other side",
+          "[contact]") {
+  const Mesh mesh = u_mesh();
+  const int a = u_node(mesh, 0.15, 1.0), b = u_node(mesh, 0.35, 1.0);
+  REQUIRE(a >= 0);
+  REQUIRE(b >= 0);
+  const std::vector<double> reach = {0.05};
+  std::vector<double> x = mesh.x;
+  // a 1e-4 along b's top edge and 2e-5 below it: inside the right arm, within b's zone (5e-4).
+  x[2 * a] = 0.35 + 1e-4, x[2 * a + 1] = 1.0 - 2e-5;
+  auto slot_a = [&](const ContactSet& set) -> const ContactSlot& { return slot_of(set, a); };
+  // Found at the vertex (no step start known: any depth), then the step starts there.
+  ContactSet kept;
+  setup_self_contact(kept, mesh);
+  kept.detect({&x}, reach);
+  REQUIRE(slot_a(kept).m0 == b);
+  REQUIRE(slot_a(kept).zone);
+  kept.remember_fronts({&x});
+  kept.detect({&x}, reach);
+  CHECK(slot_a(kept).m0 == b);
+  CHECK(slot_a(kept).m1 == -1);
+  CHECK(slot_a(kept).gap < 0);
+  // Not there at the last detection: 2e-5 behind the vertex against a bound of the floor, the
+  // other side.
+  ContactSet fresh;
+  setup_self_contact(fresh, mesh);
+  fresh.remember_fronts({&x});
+  fresh.detect({&x}, reach);
+  CHECK(slot_a(fresh).m0 == -1);
+  CHECK(std::isinf(slot_a(fresh).gap));
+}
+
 // The same two corners, a outside b's zone: a is nearest to the vertex b itself, so its normal is
 // the direction from b and its gap the distance (exact), while b is within a's zone (a's edges,
 // stretched across the slot, make it wide) and has a's pseudo-normal and the distance to a's
