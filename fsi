@@ -479,6 +479,20 @@ print("      -> 2.73, 2.77 ms; 7.49, 7.72 -> 7.07, 7.22 ms per step; the same bi
 print("  -march=native (FSI_NATIVE) | the stencil loops vectorised with AVX2 | the same")
 print("      segment, portable and native alternately: the fluid's predictor phase 4.90, 4.79 ->")
 print("      3.94, 4.28 s; the whole step 8.42, 7.88 -> 8.15, 8.54 ms (within the machine's noise)")
+print("  modified Newton in contact steps (the factor kept while the residual falls 100x per")
+print("      iteration; was: every iteration in contact factorised) | two factorisations of three")
+print("      per contact step | h = 0, upwind3, 2000 steps from t = 11, two pairs alternately:")
+print("      factorisations 4117 -> 2309; 7.13, 9.25 -> 6.24, 7.10 ms per step")
+print("  the assembly without the neo-Hookean energy (log1p, expm1 and pow per element) | -20 %")
+print("      of the assembly | the same segment, two pairs: assembly 2.26, 2.57 -> 1.96, 1.96 s;")
+print("      6.24, 7.10 -> 5.60, 5.83 ms per step")
+print("  self-contact detection through bins of the surface edges; the footprint's faces")
+print("      radix-sorted (the folds on the two walls span the grid) | -0.2 ms each (perf: 5 % of")
+print("      the solid, 9 % of the coupler) | the same segment, one run: the same bits; 5.60, 5.83")
+print("      -> 6.02 ms per step, footprint 1.50, 1.77 -> 1.39 ms (within the machine's noise)")
+print("  to t = 12 with all of these and two robustness rules (runs/vocal-folds/README.md): 1 477")
+print("      -> 1 363 s (6.16 -> 5.68 ms per step; solid 2.85 -> 1.97, footprint 1.44 -> 1.81,")
+print("      fluid 1.67 -> 1.70 ms)")
 PY
 }
 
