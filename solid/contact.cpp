@@ -34,7 +34,8 @@ constexpr double kSelfVertexZone = 0.01;
 // times its motion since the step's start, relative to the feature's point under it (plus the
 // accepted gap, at least kKeepEdge reaches; at most one reach, except at the guarded features:
 // what it faced at the step's start or touches now). Behind a guarded feature within that bound,
-// having been in front of it at the start, the node went through it (detect_self).
+// having been in front of it at the start, the node went through it (detect_self). Not for the
+// vertex whose zone held the node at the last detection and holds it still (kept_zone).
 constexpr double kSelfCrossing = 2;
 const std::vector<double> kNoPositions;
 
@@ -652,12 +653,12 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
                                   std::max(kKeepEdge * reach, m_gap_tol));
     }
     // Except the vertex whose zone held the node at the last detection and holds it now: within
-    // a zone (a hundredth of an edge from the vertex) the node is at that vertex, not at the
-    // body's other side, and the bound, twice a motion that changes from one Newton iteration
-    // to the next, took and dropped it by turns. Two nodes of a creased fold pressed onto each
-    // other (vocal folds at h = 0, upwind3): behind the other's vertex by 1.26e-5 and 1.46e-5
-    // against bounds of 0.91e-5 and 3.4e-5 in alternate iterations, so the pair was joined in
-    // one iteration and not in the next, and Newton cycled through every step cutback.
+    // a zone (one or two hundredths of an edge from the vertex) the node is at that vertex, not
+    // at the body's other side, and the bound, twice a motion that changes from one Newton
+    // iteration to the next, took and dropped it by turns. Two nodes of a creased fold pressed
+    // onto each other (vocal folds at h = 0, upwind3): behind the other's vertex by 1.26e-5 and
+    // 1.46e-5 against bounds of 0.91e-5 and 3.4e-5 in alternate iterations, so the pair was
+    // joined in one iteration and not in the next, and Newton cycled through every cutback.
     const bool kept_zone = in_zone && s.zone && s.m1 < 0 && s.m0 == zone;
     if (g < -cross && !kept_zone) continue;
     auto offer = [&](Feature& f) {

@@ -46,8 +46,9 @@ inline Eigen::Matrix2d displacement_gradient(const ElementGeometry& g, const dou
 //   K_ai,bj = A0 [ (B^T D B)_ai,bj + delta_ij dN_a/dX_J S_JK dN_b/dX_K ],
 // with the Green-Lagrange variation rows B = dE/dx:
 //   dE11 = F_i1 dN_a/dX1,  dE22 = F_i2 dN_a/dX2,  2 dE12 = F_i1 dN_a/dX2 + F_i2 dN_a/dX1.
-// u0, u1, u2 are the nodal displacements. Returns the strain energy A0 W (NaN without
-// `with_energy`, evaluate_material); `ke` (row-major 6x6) may be null. `det_f` receives det F.
+// u0, u1, u2 are the nodal displacements. Returns the strain energy A0 W (neo-Hookean: NaN
+// without `with_energy`, evaluate_material); `ke` (row-major 6x6) may be null. `det_f` receives
+// det F.
 inline double element_internal(const Material& m, const ElementGeometry& g, const double* u0,
                                const double* u1, const double* u2, double fe[6], double* ke,
                                double* det_f, bool with_energy = true) {

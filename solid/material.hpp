@@ -39,8 +39,9 @@ std::string material_model_name(MaterialModel model);
 // H = F - I is the 2x2 in-plane displacement gradient (E = (H + H^T + H^T H) / 2 without the
 // cancellation of F^T F - I at small strain). Returns W per unit reference volume; S and D are
 // written when the pointers are non-null. J <= 0 gives a NaN energy for neo-Hookean. Without
-// `with_energy` W is not evaluated (the assembly needs S and D only; the neo-Hookean energy
-// takes two transcendental functions of its own) and NaN is returned.
+// `with_energy` the neo-Hookean W is not evaluated (the assembly needs S and D only; that
+// energy takes two transcendental functions of its own) and NaN is returned; St.Venant-
+// Kirchhoff returns W either way.
 double evaluate_material(const Material& m, const Eigen::Matrix2d& H, Eigen::Vector3d* S,
                          Eigen::Matrix3d* D, bool with_energy = true);
 

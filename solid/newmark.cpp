@@ -35,8 +35,9 @@ void Solver::keep_step_start() {
 // factorised: factorize_cached() then finds iteration 0's matrix factorised when its values
 // agree bit for bit, and factorises it otherwise. Either way iteration 0 solves with the factor
 // of its own matrix, so a step's result does not depend on the look-ahead. Curvature that
-// would grow the pattern is left to the step, a safeguard: the last step's converged iteration
-// has already grown the pattern for every slot it left active.
+// would grow the pattern is left to the step: a slot first activated in an iteration that
+// solved with a held factor (modified Newton adds no curvature there) may lack its entries, and
+// the step then factorises at iteration 0.
 void Solver::factorize_ahead(double dt) {
   m_ahead_fresh = false;
   if (m_bodies.empty() || m_neq == 0 || m_model.settings.analysis != Analysis::dynamic) return;

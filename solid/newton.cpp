@@ -35,9 +35,10 @@ constexpr std::size_t kResidualsNamed = 5;
 // conditions are linearised afresh in every iteration (the gaps, B, the complementarity problem
 // through the held factor), so only the tangent is an earlier one, its contact curvature that of
 // the slots active when it was factorised; the contraction test covers both. Once such a reuse
-// in contact has not contracted, the step's later iterations factorise: the held tangent had
-// sent the active set back to an earlier state, and reusing it again after the next fresh
-// factor did the same (a Newton cycle of period three, residuals 8.2e2, 0.30, 9.5e2, ...).
+// in contact has not contracted, the step's later iterations in contact factorise: the held
+// tangent had sent the active set back to an earlier state, and reusing it again after the next
+// fresh factor did the same (a Newton cycle of period three: residuals 6.3e6, 1.3e6, 7.5e3,
+// 6.3e6, ... in the vocal folds at h = 0).
 constexpr double kReuseRatio = 1e-2;
 // A dynamic step starts with the factor the last step solved with (kept across steps) when that
 // step's first solve cut the residual by at least this factor: the matrix of a body whose
