@@ -259,12 +259,15 @@ void ContactSet::bin_edges(const Surface& surf, const std::vector<double>& x, do
   }
   for (std::size_t c = 1; c < bins.start.size(); ++c) bins.start[c] += bins.start[c - 1];
   bins.edges.resize(static_cast<std::size_t>(bins.start.back()));
-  std::vector<int> fill(bins.start.begin(), bins.start.end() - 1);
+  // Filled through start[c] as bin c's insertion point, which then holds bin c + 1's start:
+  // shifted back by one bin afterwards (no scratch array per detection).
   for (int k = 0; k < static_cast<int>(edges.size()); ++k) {
     range(k, r);
     for (int j = r[2]; j <= r[3]; ++j)
-      for (int i = r[0]; i <= r[1]; ++i) bins.edges[fill[i + bins.nx * j]++] = k;
+      for (int i = r[0]; i <= r[1]; ++i) bins.edges[bins.start[i + bins.nx * j]++] = k;
   }
+  for (std::size_t c = bins.start.size() - 1; c > 0; --c) bins.start[c] = bins.start[c - 1];
+  bins.start[0] = 0;
 }
 
 // Two nodes a and b of one surface, each at the other's vertex (a curled fold's two shoulders
