@@ -180,11 +180,19 @@ class ImmersedSolid {
 
   const proto::BodyMeshes& m_meshes;
   Family m_uf, m_vf;
-  Fixed m_fixed_u, m_fixed_v;  // rigid fixed bodies' pieces, clipped once
-  Raw m_raw_u, m_raw_v;
-  bool m_fixed_done = false;
-  Faces m_u, m_v;
-  Scratch m_scratch_u, m_scratch_v;
+  // What each family's thread writes starts a cache line of its own: a piece appended to one
+  // family's list must not invalidate the line holding the other's (the two threads would
+  // hand it back and forth at every piece).
+  static constexpr std::size_t kLine = 64;
+  alignas(kLine) Fixed m_fixed_u;  // rigid fixed bodies' pieces, clipped once
+  alignas(kLine) Fixed m_fixed_v;
+  alignas(kLine) Raw m_raw_u;
+  alignas(kLine) Raw m_raw_v;
+  alignas(kLine) Faces m_u;
+  alignas(kLine) Faces m_v;
+  alignas(kLine) Scratch m_scratch_u;
+  alignas(kLine) Scratch m_scratch_v;
+  alignas(kLine) bool m_fixed_done = false;
   bool m_threads = false;  // the two families on two threads (more than one core)
 };
 
