@@ -109,24 +109,48 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
 // One Newmark step of dt from the current state, or, when it fails and `cutbacks` > 0, two
 // steps of dt/2 from the same start (each a span with one cutback less). `parts`: how many such
 // steps the caller's step is cut into at this depth (1 for the whole step), for the messages.
+// A step that failed from the predicted iterate (settings.predictor) is first taken again from
+// x^n at the same dt: the predictor changes where Newton starts, not what the step solves, so a
+// start it makes worse (a node predicted into a closing contact, an active set that cycles from
+// there) must not cost the run a cutback, nor the run itself where no cutback is left.
 // The contact forces left on the bodies are the mean over the span's steps: each is the force
 // over its own step (Newmark: lambda / 2 acts over the step, Eq. 13-14), so the mean has the
 // span's impulse.
 StepReport Solver::newmark_span(double dt, const std::vector<std::vector<double>>* external,
                                 const std::string& when, int cutbacks, int parts) {
   StepState start;
-  if (cutbacks > 0) save_state(start);
+  const bool may_predict = m_model.settings.predictor == Predictor::acceleration;
+  if (cutbacks > 0 || may_predict) save_state(start);
   const std::string here =
       parts == 1 ? when : fmt::format("{}, cut into steps of dt/{} (this one from t = {:.9g})",
                                       when, parts, m_time);
+  auto note = [&](const StepFailed& e, const std::string& then) {
+    if (m_cutback_notes++ >= kCutbackNotes) return;
+    const std::string what = e.what();
+    std::fprintf(stderr, "[solid] note: %s; %s\n", what.substr(0, what.find('\n')).c_str(),
+                 then.c_str());
+  };
+  const std::string halves = fmt::format("taken again as two steps of dt/{}", 2 * parts);
+  bool predicted = false;
   try {
     return newmark_step(dt, external, here);
   } catch (const StepFailed& e) {
-    if (cutbacks == 0) throw;
-    if (m_cutback_notes++ < kCutbackNotes) {
-      const std::string what = e.what();
-      std::fprintf(stderr, "[solid] note: %s; taken again as two steps of dt/%d\n",
-                   what.substr(0, what.find('\n')).c_str(), 2 * parts);
+    predicted = m_predictor_moved;
+    if (!predicted && cutbacks == 0) throw;
+    note(e, predicted ? "taken again from x^n (solid.predictor)" : halves);
+  }
+  if (predicted) {
+    restore_state(start);
+    m_predictor_off = true;
+    try {
+      StepReport rep = newmark_step(dt, external, here);
+      m_predictor_off = false;
+      ++m_unpredicted_retries;
+      return rep;
+    } catch (const StepFailed& e) {
+      m_predictor_off = false;
+      if (cutbacks == 0) throw;
+      note(e, halves);
     }
   }
   restore_state(start);
@@ -214,7 +238,8 @@ void Solver::predict(double t1, double dt, const std::vector<std::vector<double>
   if (m_root_mass)
     for (const auto& m : *m_root_mass)
       for (double v : m) root_masses = root_masses || v != 0;
-  if (m_model.settings.predictor != Predictor::acceleration || any_contact_active() ||
+  if (m_model.settings.predictor != Predictor::acceleration || m_predictor_off ||
+      any_contact_active() ||
       prescribed_increment || root_masses)
     return;
   if (!m_ahead_fresh && !m_iteration_velocity && root_mass_tangent_lagged()) factorize_ahead(dt);

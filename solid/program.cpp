@@ -323,6 +323,10 @@ nlohmann::json SolidProgram::report() const {
   j["steps"] = m_steps;
   if (m_repeats > 0) j["repeated_steps"] = m_repeats;
   j["cut_steps"] = m_cut_steps;  // failed whole, taken in parts (step_cutbacks)
+  // Steps (or parts) that failed from the predicted iterate and converged from x^n, since this
+  // process started.
+  if (m_cfg.model.settings.predictor == Predictor::acceleration)
+    j["unpredicted_retries"] = s.unpredicted_retries();
   j["newton_iterations"] = m_newton_total;
   j["newton_iterations_max"] = m_newton_max;
   j["phases"] = {{"assembly", m_assembly}, {"factorization", m_factor}, {"solve", m_solve}};

@@ -115,6 +115,7 @@ class Solver {
   long factor_reuses() const { return m_factor_reuses; }
   // Steps that failed whole and were taken in halves (settings.step_cutbacks).
   long cut_steps() const { return m_cut_steps; }
+  long unpredicted_retries() const { return m_unpredicted_retries; }
   long factorizations() const { return m_factorizations; }
   // Times a contact working set grew within an iteration (solve_contact): a candidate the free
   // step left open was taken through by the constrained one.
@@ -294,6 +295,8 @@ class Solver {
   // step starts from, its c0, no active contact. Read and cleared by the step's newton().
   bool m_ahead_fresh = false;
   bool m_predictor_moved = false;  // predict() moved an elastic node off x^n this step
+  bool m_predictor_off = false;    // newmark_span(): a failed predicted step taken from x^n
+  long m_unpredicted_retries = 0;  // steps that failed predicted and converged from x^n
   LinearSolver m_mass_solver;      // the mass matrix on the free equations (factorize_mass)
   int m_mass_state = 0;            // 0: not factorised yet, 1: factorised, -1: singular
   ContactSet m_contact;
