@@ -192,7 +192,7 @@ class ImmersedSolid {
   alignas(kLine) Faces m_v;
   alignas(kLine) Scratch m_scratch_u;
   alignas(kLine) Scratch m_scratch_v;
-  alignas(kLine) bool m_fixed_done = false;
+  bool m_fixed_done = false;  // set after both threads are done
   bool m_threads = false;  // the two families on two threads (more than one core)
 };
 

@@ -22,7 +22,8 @@ SpongeWeights sponge_weights(const Grid& g, double blend = 0.0);
 // Over the active u faces i in [i0, nx), j in [0, ny), and v faces i in [0, nx), j in [j0, ny):
 //   hu = -d(uu)/dx - d(vu)/dy + nu_e lap(u),   hv = -d(uv)/dx - d(vv)/dy + nu_e lap(v)
 // and, when lu/lv are given, lu = lap(u), lv = lap(v). nu_e is the kinematic viscosity for
-// explicit diffusion and 0 for implicit. Ghosts of u and v must be filled.
+// explicit diffusion and 0 for implicit. Ghosts of u and v must be filled. hu, hv, lu and lv
+// are other fields than u and v (the kernel's loops are compiled on that promise).
 void momentum_terms(const Grid& g, const SpongeWeights& sw, const Field& u, const Field& v,
                     double nu_e, int i0, int j0, Field& hu, Field& hv, Field* lu, Field* lv);
 

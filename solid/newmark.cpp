@@ -59,13 +59,15 @@ void Solver::factorize_ahead(double dt) {
 // One step t^n -> t^(n+1) = t^n + dt:
 //   R(x) = F(t^(n+1)) - Q(x) - (4/dt^2) M (x - x^n - dt v^n) + (M a)^n + 2 F_c,
 // R(x^(n+1)) + B^T lambda = 0 with the contact conditions, then the trapezoidal update.
-// A step that fails (StepFailed) is taken again from its start as two steps of dt/2 with the
-// same external forces, each of which may be halved again, settings.step_cutbacks times at most
+// A step that fails (StepFailed) from the predicted iterate is taken again from x^n; one that
+// fails from x^n is taken again from its start as two steps of dt/2 with the same external
+// forces, each of which may be halved again, settings.step_cutbacks times at most
 // (newmark_span); the step then ends at t^(n+1) as one step does.
 StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* external,
                            const std::vector<std::vector<double>>* iteration_velocity,
                            const std::vector<std::vector<double>>* root_mass) {
   m_failed_start_kept = false;
+  m_predictor_off = false;
   if (!(dt > 0)) fsi::fail("time step must be > 0, got {}", dt);
   if (m_bodies.empty()) {  // a scene without bodies: only the clock moves
     m_time += dt;
@@ -95,6 +97,7 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
     m_iteration_velocity = nullptr;
     m_root_mass = nullptr;
     m_keep_allowed = false;
+    m_predictor_off = false;
     throw;
   }
   m_iteration_velocity = nullptr;
@@ -124,24 +127,32 @@ StepReport Solver::newmark_span(double dt, const std::vector<std::vector<double>
   const std::string here =
       parts == 1 ? when : fmt::format("{}, cut into steps of dt/{} (this one from t = {:.9g})",
                                       when, parts, m_time);
-  auto note = [&](const StepFailed& e, const std::string& then) {
-    if (m_cutback_notes++ >= kCutbackNotes) return;
+  // Notes of retries from x^n and of cutbacks are limited separately: a run with the predictor
+  // may retry often, and the cutbacks' notes are the ones that point at a problem.
+  auto note = [&](const StepFailed& e, bool retry) {
+    if ((retry ? m_retry_notes : m_cutback_notes)++ >= kCutbackNotes) return;
     const std::string what = e.what();
+    const std::string then =
+        retry ? std::string("taken again from the step's start without the predictor "
+                            "(solid.predictor)")
+              : fmt::format("taken again as two steps of dt/{}", 2 * parts);
     std::fprintf(stderr, "[solid] note: %s; %s\n", what.substr(0, what.find('\n')).c_str(),
                  then.c_str());
   };
-  const std::string halves = fmt::format("taken again as two steps of dt/{}", 2 * parts);
   bool predicted = false;
   try {
     return newmark_step(dt, external, here);
   } catch (const StepFailed& e) {
     predicted = m_predictor_moved;
     if (!predicted && cutbacks == 0) throw;
-    note(e, predicted ? "taken again from x^n (solid.predictor)" : halves);
+    note(e, predicted);
   }
   if (predicted) {
     restore_state(start);
-    m_predictor_off = true;
+    // The failed attempt's last factor is not the matrix at x^n: iteration 0 must not keep it
+    // (restore_state already drops a look-ahead of another state).
+    m_keep_factor = false;
+    m_predictor_off = true;  // advance() resets it should the retry throw anything else
     try {
       StepReport rep = newmark_step(dt, external, here);
       m_predictor_off = false;
@@ -150,7 +161,7 @@ StepReport Solver::newmark_span(double dt, const std::vector<std::vector<double>
     } catch (const StepFailed& e) {
       m_predictor_off = false;
       if (cutbacks == 0) throw;
-      note(e, halves);
+      note(e, false);
     }
   }
   restore_state(start);

@@ -34,8 +34,9 @@ struct StepReport {
 };
 
 // A step the solver could not take: Newton did not converge, an element turned inside out, the
-// state or the residual is not finite. advance() redoes such a step in halves
-// (Settings::step_cutbacks) before it gives up.
+// state or the residual is not finite. advance() redoes such a step from x^n when it started
+// from the predicted iterate (Settings::predictor), then in halves (Settings::step_cutbacks),
+// before it gives up.
 class StepFailed : public fsi::Error {
  public:
   using fsi::Error::Error;
@@ -115,6 +116,8 @@ class Solver {
   long factor_reuses() const { return m_factor_reuses; }
   // Steps that failed whole and were taken in halves (settings.step_cutbacks).
   long cut_steps() const { return m_cut_steps; }
+  // Steps (or parts) that failed from the predicted iterate and converged from x^n, since the
+  // solver was made (not kept in checkpoints).
   long unpredicted_retries() const { return m_unpredicted_retries; }
   long factorizations() const { return m_factorizations; }
   // Times a contact working set grew within an iteration (solve_contact): a candidate the free
@@ -280,6 +283,7 @@ class Solver {
   long m_factorizations = 0;
   long m_working_set_growths = 0;
   long m_cut_steps = 0, m_cutback_notes = 0;  // advance(): steps cut back, notes printed
+  long m_retry_notes = 0;                      // notes printed of steps taken again from x^n
   StepState m_failed_start;  // failed_step_start()
   bool m_failed_start_kept = false;
   // A dynamic step may start with the factor the last one solved with (newton.cpp, kKeepRatio):

@@ -226,7 +226,8 @@ TEST_CASE("a step that fails from the predicted iterate is taken again from x^n"
   }
   CHECK(touched);
   INFO("steps taken again from x^n: " << predicted.unpredicted_retries());
-  CHECK(predicted.unpredicted_retries() > 0);
+  // More than one: after a retry the next steps start from the predicted iterate again.
+  CHECK(predicted.unpredicted_retries() > 1);
   CHECK(predicted.cut_steps() == 0);
   const std::vector<double>& x = predicted.positions(0);
   const std::vector<double>& y = plain.positions(0);
