@@ -493,6 +493,17 @@ print("      -> 6.02 ms per step, footprint 1.50, 1.77 -> 1.39 ms (within the ma
 print("  to t = 12 with all of these and two robustness rules (runs/vocal-folds/README.md): 1 477")
 print("      -> 1 363 s (6.16 -> 5.68 ms per step; solid 2.85 -> 1.97, footprint 1.44 -> 1.81,")
 print("      fluid 1.67 -> 1.70 ms)")
+print("  the convection-diffusion kernel's loops vectorised (GCC wanted more run-time alias checks")
+print("      than it makes; the outputs are other fields, said with #pragma GCC ivdep) | the fluid's")
+print("      predictor down | the same segment (51 % of the steps sub-cycled), alternately: predictor")
+print("      phase 3.44, 3.50 -> 2.20, 2.07 s; the same bits")
+print("  each footprint thread's lists on cache lines of their own (the u- and v-families' piece")
+print("      lists were neighbours: each append invalidated the other thread's line; perf: 58 % of")
+print("      the piece emitter on the list's end) | footprint down | the same segment, three pairs on")
+print("      a loaded machine: footprint 2.22, 2.05, 2.07 -> 1.67, 1.51, 1.67 ms; the same bits")
+print("  to t = 12 with both, alone: 1 363 -> 1 218 s (5.68 -> 5.07 ms per step; solid 1.97 -> 1.89,")
+print("      footprint 1.81 -> 1.35, fluid 1.70 -> 1.65 ms; CPU 2 694 -> 2 404 s); the same")
+print("      trajectory (67 closures, impulse ratio 0.0600)")
 PY
 }
 
