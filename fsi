@@ -504,6 +504,10 @@ print("      a loaded machine: footprint 2.22, 2.05, 2.07 -> 1.67, 1.51, 1.67 ms
 print("  to t = 12 with both, alone: 1 363 -> 1 218 s (5.68 -> 5.07 ms per step; solid 1.97 -> 1.89,")
 print("      footprint 1.81 -> 1.35, fluid 1.70 -> 1.65 ms; CPU 2 694 -> 2 404 s); the same")
 print("      trajectory (67 closures, impulse ratio 0.0600)")
+print("  tried, not kept: the footprint's second thread kept from step to step (a futex wait between")
+print("      steps; was: a thread started and joined per step) | -0.1 ms | the same segment, three")
+print("      pairs: footprint 1.38, 1.34, 1.23 against 1.77, 1.27, 1.20 ms, within the noise; one")
+print("      thread instead of two: 1.68, 1.55, 1.48 against 1.22, 1.23, 1.21 ms (two stay)")
 PY
 }
 
