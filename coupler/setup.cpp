@@ -85,8 +85,9 @@ void Coupler::check_can_iterate() const {
   auto refuse = [&](const char* program) {
     throw fsi::InputError(fmt::format(
         "coupler.iterations.max = {} asks every step to be repeated, but the {} program cannot "
-        "repeat a step (its port does not implement coupled iterations, or a fluid takes "
-        "substeps: fluid.substeps.max > 1); set max = 1 (in {})",
+        "repeat a step (its port does not implement coupled iterations, a fluid takes "
+        "substeps: fluid.substeps.max > 1, or the solid's Newmark step is not the trapezoidal "
+        "rule: solid.newmark_gamma, newmark_beta); set max = 1 (in {})",
         m_iter.max, program, m_rt.scene().file().string()));
   };
   if (has(Role::fluid) && !m_grid.can_iterate) refuse("fluid");

@@ -28,8 +28,9 @@ void Solver::add_scene_loads(const Body& B, double t, std::vector<double>& f) co
   }
 }
 
-// Residual on the free equations, for Newmark (c0 = 4 / dt^2) or statics (c0 = 0):
-//   R = F(t) - Q(x) - c0 M (x - x^n - dt v^n) + (M a)^n,
+// Residual on the free equations, for Newmark (c0 = 1 / (beta dt^2), 4 / dt^2 in the
+// trapezoidal rule) or statics (c0 = 0):
+//   R = F(t) - Q(x) - c0 M (x - x^n - dt v^n) + (1/2 - beta) / beta (M a)^n + F_c / (2 beta),
 // with Q_a = sum_e A0 F S dN_a/dX (element.hpp) and, when with_matrix,
 //   K_eff = dQ/dx + c0 M  (material + geometric stiffness plus the Newmark mass term).
 // `time_or_factor` is t^(n+1) in dynamics and the load factor in statics.
@@ -79,9 +80,13 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
     // solid receives the whole impulse in the step the fluid lost it, so momentum balances step
     // by step. Averaging it over two steps delays the reaction and pumps energy into the solid's
     // element-scale modes. Massless dofs (rho_s = rho_f) are quasi-static: F - Q + F_c = 0.
+    // With other Newmark parameters (M a)^n enters with (1/2 - beta) / beta and F_c with
+    // 1 / (2 beta) (Eq. 13 solved for a^(n+1)); both are exact in the trapezoidal rule (1, 2).
+    const double w_ma = newmark_ma_weight(), w_impulse = newmark_impulse_weight();
     for (std::size_t d = 0; d < r.size(); ++d)
-      r[d] = B.f_ext[d] +
-             (dynamic ? B.ma[d] + (B.mass_row[d] > 0 ? 2.0 : 1.0) * B.f_cpl[d] : B.f_cpl[d]);
+      r[d] = B.f_ext[d] + (dynamic ? w_ma * B.ma[d] +
+                                         (B.mass_row[d] > 0 ? w_impulse : 1.0) * B.f_cpl[d]
+                                   : B.f_cpl[d]);
     std::vector<double>& absq = B.abs_q;  // |element forces| and |K| |u|: scales of R
     std::vector<double>& absm = B.abs_floor;
     std::fill(absq.begin(), absq.end(), 0.0);
@@ -193,10 +198,11 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
       r[d] -= B.q[d];
       if (B.eq[d] >= 0) {
         m_residual[B.eq[d]] += r[d];
-        // The coupling force counts as it enters r: twice with mass, once on a massless dof.
-        const double w_cpl = dynamic && B.mass_row[d] > 0 ? 2.0 : 1.0;
+        // The coupling force counts as it enters r: 1 / (2 beta) with mass, once on a massless
+        // dof.
+        const double w_cpl = dynamic && B.mass_row[d] > 0 ? w_impulse : 1.0;
         const double s = std::abs(B.f_ext[d]) + w_cpl * std::abs(B.f_cpl[d]) + absq[d] +
-                         (dynamic ? std::abs(B.ma[d]) : 0.0);
+                         (dynamic ? std::abs(w_ma * B.ma[d]) : 0.0);
         scale2 += s * s;
         floor2 += (s + absm[d]) * (s + absm[d]);
       }

@@ -294,6 +294,19 @@ Config read_config(const fsi::SceneTable& s, double fluid_density) {
                          "acceleration"
                      ? Predictor::acceleration
                      : Predictor::none;
+  // gamma in [1/2, 1]; beta defaults to (gamma + 1/2)^2 / 4, the member of the family that
+  // damps the highest frequencies most for this gamma, and must keep 2 beta >= gamma (the
+  // condition for unconditional stability in the linear regime). Only when given: a scene
+  // without them keeps its effective scene (and its checkpoints) as it was.
+  if (s.has("newmark_gamma") || s.has("newmark_beta")) {
+    st.newmark_gamma = s.in_range("newmark_gamma", 0.5, 1.0, false, defaults.newmark_gamma);
+    const double beta_default = 0.25 * (st.newmark_gamma + 0.5) * (st.newmark_gamma + 0.5);
+    st.newmark_beta = s.in_range("newmark_beta", 0.0, 1.0, true, beta_default);
+    if (2 * st.newmark_beta < st.newmark_gamma)
+      s.fail("newmark_beta", fmt::format("must be at least newmark_gamma / 2 = {} "
+                                         "(unconditional stability), got {}",
+                                         st.newmark_gamma / 2, st.newmark_beta));
+  }
   c.modes = static_cast<int>(s.integer("modes", 0));
   if (c.modes < 0) s.fail("modes", fmt::format("must be >= 0, got {}", c.modes));
   c.initial_mode = static_cast<int>(s.integer("initial_mode", 0));

@@ -112,6 +112,13 @@ struct Settings {
   double contact_tolerance = 1e-10;  // on the gap, relative to the smallest element edge
   bool keep_factor = true;  // a dynamic step may start with the last step's factor (newton.cpp)
   Predictor predictor = Predictor::none;  // opt-in (solid/README.md, "The predictor")
+  // The Newmark parameters of the paper's Eq. 13-14. The trapezoidal rule (1/4, 1/2, the
+  // paper's choice) keeps every mode's energy; gamma > 1/2 with 2 beta >= gamma damps the energy
+  // of a mode of angular frequency omega at the rate (gamma - 1/2) omega^2 dt to leading order
+  // (solid/README.md, "Newmark's parameters").
+  double newmark_beta = 0.25;
+  double newmark_gamma = 0.5;
+  bool trapezoidal() const { return newmark_beta == 0.25 && newmark_gamma == 0.5; }
 };
 
 struct Model {

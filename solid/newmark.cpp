@@ -1,4 +1,5 @@
-// The Newmark step (beta = 1/4, gamma = 1/2, the trapezoidal rule): the predictor, Newton on the
+// The Newmark step (paper Eq. 13-14; beta = 1/4, gamma = 1/2, the trapezoidal rule, unless the
+// scene sets solid.newmark_gamma / newmark_beta): the predictor, Newton on the
 // step's residual with contact (newton.cpp), the velocity and acceleration update; and the
 // look-ahead factorisation of the next step's first matrix.
 #include <cstdio>
@@ -10,10 +11,6 @@ namespace solid {
 
 namespace {
 
-// Physical contact force per multiplier in a Newmark step. The multiplier balances the
-// trapezoidal residual, in which a force acting over the step enters with weight 2 (as the
-// coupling force does, assembly.cpp): the force on the bodies is lambda / 2.
-constexpr double kNewmarkContactForceFactor = 0.5;
 // Failed attempts (of a step or of one of its parts) noted on stderr; later ones are not noted,
 // the steps they cut are still counted (Solver::cut_steps).
 constexpr long kCutbackNotes = 10;
@@ -57,8 +54,10 @@ void Solver::factorize_ahead(double dt) {
 }
 
 // One step t^n -> t^(n+1) = t^n + dt:
-//   R(x) = F(t^(n+1)) - Q(x) - (4/dt^2) M (x - x^n - dt v^n) + (M a)^n + 2 F_c,
-// R(x^(n+1)) + B^T lambda = 0 with the contact conditions, then the trapezoidal update.
+//   R(x) = F(t^(n+1)) - Q(x) - c0 M (x - x^n - dt v^n) + w_a (M a)^n + w_c F_c,
+// (c0, w_a, w_c = 4/dt^2, 1, 2 in the trapezoidal rule; 1/(beta dt^2), (1/2 - beta)/beta,
+// 1/(2 beta) otherwise), R(x^(n+1)) + B^T lambda = 0 with the contact conditions, then the
+// velocity update (update_velocity).
 // A step that fails (StepFailed) from the predicted iterate is taken again from x^n; one that
 // fails from x^n is taken again from its start as two steps of dt/2 with the same external
 // forces, each of which may be halved again, settings.step_cutbacks times at most
@@ -85,6 +84,22 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
   // (assembly.cpp); without a fluid there is no reaction to linearise.
   m_iteration_velocity = m_model.settings.fluid_density > 0 ? iteration_velocity : nullptr;
   m_root_mass = root_mass;
+  if (!m_model.settings.trapezoidal()) {
+    // The linearised reaction of coupled iterations and the fibers' root inertia are written for
+    // the trapezoidal rule's velocity (assembly.cpp, Body::step_velocity).
+    bool root_masses = false;
+    if (root_mass)
+      for (const auto& m : *root_mass)
+        for (double v : m) root_masses = root_masses || v != 0;
+    if (m_iteration_velocity || root_masses) {
+      m_iteration_velocity = nullptr;
+      m_root_mass = nullptr;
+      fsi::fail("solid.newmark_gamma = {}, newmark_beta = {}: {} need the trapezoidal rule "
+                "(newmark_gamma = 0.5, newmark_beta = 0.25)",
+                m_model.settings.newmark_gamma, m_model.settings.newmark_beta,
+                root_masses ? "fibers rooted on an elastic body" : "coupled iterations");
+    }
+  }
   StepReport rep;
   m_keep_allowed = m_model.settings.keep_factor && m_keep_permitted;
   if (!m_keep_allowed) m_keep_factor = false;
@@ -117,7 +132,7 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
 // start it makes worse (a node predicted into a closing contact, an active set that cycles from
 // there) must not cost the run a cutback, nor the run itself where no cutback is left.
 // The contact forces left on the bodies are the mean over the span's steps: each is the force
-// over its own step (Newmark: lambda / 2 acts over the step, Eq. 13-14), so the mean has the
+// over its own step (Newmark: 2 beta lambda acts over the step, Eq. 13-14), so the mean has the
 // span's impulse.
 StepReport Solver::newmark_span(double dt, const std::vector<std::vector<double>>* external,
                                 const std::string& when, int cutbacks, int parts) {
@@ -194,7 +209,10 @@ StepReport Solver::newmark_step(double dt, const std::vector<std::vector<double>
                                 const std::string& when) {
   const double t1 = m_time + dt;
   predict(t1, dt, external);
-  m_contact_force_factor = kNewmarkContactForceFactor;
+  // Physical contact force per multiplier: the multiplier balances the residual, in which a
+  // force acting over the step enters with the weight 1 / (2 beta) (as the coupling force does,
+  // assembly.cpp): the force on the bodies is 2 beta lambda (lambda / 2 in the trapezoidal rule).
+  m_contact_force_factor = 2 * m_model.settings.newmark_beta;
   StepReport rep = newton(newmark_c0(dt), dt, t1, external, when);
   // The next step's tangent (and its look-ahead factorisation) takes this step's root masses.
   m_root_mass_tangent = m_root_mass ? *m_root_mass : std::vector<std::vector<double>>{};
@@ -221,10 +239,10 @@ void Solver::initial_acceleration(double dt) {
 // self-contact remembers what each node faces at x^n. Then, with settings.predictor =
 // "acceleration", the elastic bodies' free dofs with mass move to the trapezoidal step taken
 // with the forces of the step's start: in the residual (assembly.cpp) put
-// (F - Q)^(n+1) = (F - Q)^n = (M a)^n and keep this step's coupling force F_c (it enters twice,
-// 2 F_c); no contact (no slot is active at the start):
-//   (4/dt^2) M (x - x^n - dt v^n) = 2 ((M a)^n + F_c)
-//   x = x^n + dt v^n + (dt^2 / 2) M^-1 ((M a)^n + F_c),
+// (F - Q)^(n+1) = (F - Q)^n = (M a)^n and keep this step's coupling force F_c; no contact (no
+// slot is active at the start). Eq. 13 with a^(n+1) = a^n gives, for any beta,
+//   x = x^n + dt v^n + (dt^2 / 2) M^-1 ((M a)^n + F_c)
+// (in the trapezoidal residual: (4/dt^2) M (x - x^n - dt v^n) = 2 ((M a)^n + F_c)),
 // M the consistent mass on the free equations (factorize_mass; a lumped one leaves the rough
 // part of the fluid's force in the first residual). Newton's first residual is then the change
 // of F - Q over the step, not the step's whole inertia (4/dt) M v^n (solid/README.md, "The
@@ -298,7 +316,8 @@ bool Solver::factorize_mass() {
   m_mass_state = m_mass_solver.factorize(mass) ? 1 : -1;
   if (m_mass_state < 0)
     std::fprintf(stderr, "[solid] note: the mass matrix is singular: solid.predictor = "
-                         "\"acceleration\" is off for this run\n");
+                         "\"acceleration\" is off for this run, and newmark_gamma > 0.5 stops "
+                         "at its first step\n");
   return m_mass_state > 0;
 }
 
@@ -309,16 +328,51 @@ void Solver::remember_fronts() {
   m_contact.remember_fronts(xs, contact_gap_tolerance());
 }
 
-// Newmark velocity from the positions, v^(n+1) = 2 (x^(n+1) - x^n) / dt - v^n (the trapezoidal
-// rule), and (M a)^(n+1) = F - Q: the acceleration without the contact part (Eq. 13-16).
+// Newmark velocity from the positions and (M a)^(n+1) = F - Q: the acceleration without the
+// contact part (Eq. 13-16). With a = M^-1 (F - Q) and the step's impulse forces
+// a_c = M^-1 (F_con + F_c) (contact and coupling: dt^2/2 a_c in x, dt a_c in v), Eq. 13 gives
+//   dt^2 beta a^(n+1) = x^(n+1) - x^n - dt v^n - dt^2 (1/2 - beta) a^n - dt^2/2 a_c,
+// and Eq. 14 with it
+//   v^(n+1) = gamma / (beta dt) (x^(n+1) - x^n) + (1 - gamma / beta) v^n
+//             + dt (1 - gamma / (2 beta)) M^-1 ((M a)^n + F_con + F_c),
+// the trapezoidal rule's v^(n+1) = 2 (x^(n+1) - x^n) / dt - v^n when gamma = 2 beta = 1/2 (no
+// solve). Otherwise M^-1 is the consistent mass on the free equations (factorize_mass), and a
+// prescribed dof's a^n is taken as 0 (its M a is not kept): the positions stay those of Eq. 13
+// (the error this leaves in the free velocities, M_ff^-1 M_fp a_p, and in the prescribed ones
+// cancels in the residual), while the velocities next to a prescribed motion that accelerates
+// are off by about dt a_p (beta / gamma - 1/2).
 // Massless dofs (rho_s = rho_f) are quasi-static: v = (x^(n+1) - x^n) / dt, (M a) = 0.
 void Solver::update_velocity(double dt) {
+  const Settings& st = m_model.settings;
+  Eigen::VectorXd accel;
+  if (!st.trapezoidal()) {
+    if (!factorize_mass())
+      fsi::fail("solid.newmark_gamma = {}: the velocity update needs the mass matrix, which is "
+                "singular; use the trapezoidal rule (newmark_gamma = 0.5)",
+                st.newmark_gamma);
+    Eigen::VectorXd force = Eigen::VectorXd::Zero(m_neq);
+    for (const auto& bp : m_bodies) {
+      const Body& B = *bp;
+      if (!B.is_elastic()) continue;
+      for (std::size_t d = 0; d < B.u.size(); ++d)
+        if (B.eq[d] >= 0 && B.mass_row[d] > 0)
+          force[B.eq[d]] += B.ma[d] + B.contact[d] + B.f_cpl[d];
+    }
+    accel = m_mass_solver.solve(force);
+  }
+  const double cx = st.newmark_gamma / (st.newmark_beta * dt);
+  const double cv = 1 - st.newmark_gamma / st.newmark_beta;
+  const double ca = dt * (1 - st.newmark_gamma / (2 * st.newmark_beta));
   for (auto& bp : m_bodies) {
     Body& B = *bp;
     if (!B.is_elastic()) continue;
     for (std::size_t d = 0; d < B.u.size(); ++d) {
       if (B.mass_row[d] > 0) {
-        B.v[d] = 2 * (B.u[d] - B.u_old[d]) / dt - B.v_old[d];
+        if (st.trapezoidal())
+          B.v[d] = 2 * (B.u[d] - B.u_old[d]) / dt - B.v_old[d];
+        else
+          B.v[d] = cx * (B.u[d] - B.u_old[d]) + cv * B.v_old[d] +
+                   (B.eq[d] >= 0 ? ca * accel[B.eq[d]] : 0.0);
         B.ma[d] = B.eq[d] >= 0 ? B.f_ext[d] - B.q[d] : 0.0;
       } else {
         B.v[d] = (B.u[d] - B.u_old[d]) / dt;

@@ -24,7 +24,8 @@ class SolidProgram : public fsi::SolidPort {
   fsi::proto::BodyMeshes meshes() const override;
   void state(fsi::proto::SolidState& s) const override;
   void advance(const fsi::proto::StepBegin& s, const fsi::proto::SolidInput& in) override;
-  bool can_iterate() const override { return true; }
+  // Coupled iterations linearise the fluid's reaction with the trapezoidal rule's velocity.
+  bool can_iterate() const override { return m_cfg.model.settings.trapezoidal(); }
   void begin(const fsi::proto::StepBegin& s) override;
   void output(long step, double t, bool fields) override;
   std::string status() const override;

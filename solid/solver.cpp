@@ -24,6 +24,11 @@ Solver::Solver(Model model, LinearSolver::Backend backend)
                                       kMaxStepCutbacks, s.step_cutbacks));
   if (s.analysis == Analysis::statics && s.load_steps < 1)
     throw fsi::InputError("load_steps must be >= 1");
+  if (!(s.newmark_gamma >= 0.5 && s.newmark_gamma <= 1) || !(s.newmark_beta > 0) ||
+      !(2 * s.newmark_beta >= s.newmark_gamma))
+    throw fsi::InputError(fmt::format("Newmark parameters beta = {}, gamma = {}: need gamma in "
+                                      "[0.5, 1] and 2 beta >= gamma > 0",
+                                      s.newmark_beta, s.newmark_gamma));
   for (std::size_t b = 0; b < m_model.bodies.size(); ++b) {
     for (std::size_t c = 0; c < b; ++c)
       if (m_model.bodies[b].name == m_model.bodies[c].name)
@@ -52,6 +57,12 @@ Solver::Solver(Model model, LinearSolver::Backend backend)
   update_rigid(0);
   update_prescribed(0);
   check_initial_overlap();
+  // The mass matrix that the predictor and a damped Newmark step's velocity solve with, on the
+  // element pattern: factorised here, before a resumed run's contact entries grow the pattern
+  // (the fill-reducing ordering depends on it), so that a resumed run continues bit for bit.
+  if (s.analysis == Analysis::dynamic && m_neq > 0 &&
+      (!s.trapezoidal() || s.predictor == Predictor::acceleration))
+    factorize_mass();
 }
 
 // Bodies of a contact pair (or a body and a contact plane) that overlap at t = 0 by more than

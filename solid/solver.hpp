@@ -67,7 +67,7 @@ struct StepState {
 };
 
 // The factor a dynamic step keeps for the next (checkpoints): the matrix values it was computed
-// from, their inertia factor c0 = 4/dt^2 and the round-off floor's matrix part at that time.
+// from, their inertia factor c0 (newmark_c0) and the round-off floor's matrix part at that time.
 struct KeptFactor {
   std::vector<double> values;  // empty: none kept
   double c0 = 0;
@@ -252,9 +252,21 @@ class Solver {
   void update_velocity(double dt);
   // u_old, v_old := u, v: the state the coming step starts from.
   void keep_step_start();
-  // The Newmark (trapezoidal) inertia factor of the effective matrix, c0 = 4 / dt^2: one
-  // expression for advance() and factorize_ahead(), whose matrices must agree bit for bit.
-  static double newmark_c0(double dt) { return 4 / (dt * dt); }
+  // The Newmark inertia factor of the effective matrix, c0 = 1 / (beta dt^2) (4 / dt^2 in the
+  // trapezoidal rule): one expression for advance() and factorize_ahead(), whose matrices must
+  // agree bit for bit.
+  double newmark_c0(double dt) const {
+    return m_model.settings.trapezoidal() ? 4 / (dt * dt)
+                                          : 1 / (m_model.settings.newmark_beta * dt * dt);
+  }
+  // The weights of (M a)^n and of a force acting as an impulse over the step (coupling,
+  // contact) in the Newmark residual of a dof with mass (assembly.cpp): (1/2 - beta) / beta and
+  // 1 / (2 beta), 1 and 2 in the trapezoidal rule.
+  double newmark_ma_weight() const {
+    const double b = m_model.settings.newmark_beta;
+    return (0.5 - b) / b;
+  }
+  double newmark_impulse_weight() const { return 0.5 / m_model.settings.newmark_beta; }
   [[noreturn]] void fail_health(const std::string& what, int body, int element,
                                 const std::string& when) const;
   void check_finite(const std::string& when) const;
@@ -304,7 +316,7 @@ class Solver {
   LinearSolver m_mass_solver;      // the mass matrix on the free equations (factorize_mass)
   int m_mass_state = 0;            // 0: not factorised yet, 1: factorised, -1: singular
   ContactSet m_contact;
-  double m_contact_force_factor = 1;  // physical contact force / multiplier (1/2 in Newmark)
+  double m_contact_force_factor = 1;  // physical contact force / multiplier (2 beta in Newmark)
   bool m_dirichlet_pending = false;   // a prescribed increment awaits the first Newton solve
   const std::vector<std::vector<double>>* m_iteration_velocity = nullptr;  // during advance()
   const std::vector<std::vector<double>>* m_root_mass = nullptr;            // during advance()

@@ -29,7 +29,8 @@ struct Solver::Body {
   std::vector<double> mass_row;     // per dof: row sum of M (zero: massless dof)
   // The weight of a force acting as an impulse over the step in dof d's trapezoidal residual
   // (2 with mass, 1 on a massless dof; assembly.cpp), and the step's velocity v^(n+1) of dof d at
-  // the iterate: s (x - x^n) / dt - [mass] v^n.
+  // the iterate: s (x - x^n) / dt - [mass] v^n. Only for the trapezoidal rule: advance() refuses
+  // the users of these (coupled iterations, root masses) with other Newmark parameters.
   double impulse_weight(std::size_t d) const { return mass_row[d] > 0 ? 2.0 : 1.0; }
   double step_velocity(std::size_t d, double dt) const {
     return impulse_weight(d) * (u[d] - u_old[d]) / dt - (mass_row[d] > 0 ? v_old[d] : 0.0);

@@ -127,6 +127,28 @@ TEST_CASE("step_cutbacks: the default, a value, and out of range", "[config][inp
                     Catch::Contains("solid.step_cutbacks") && Catch::Contains("got -1"));
 }
 
+TEST_CASE("newmark_gamma and newmark_beta: the default, the derived beta, out of range",
+          "[config][input]") {
+  const std::string mat = "density = 1\nyoungs_modulus = 1\npoisson_ratio = 0.3\n";
+  auto with = [&](const std::string& keys) {
+    std::string text = with_material(mat);
+    text.replace(text.find("[solid]\n"), 8, "[solid]\n" + keys + "\n");
+    return text;
+  };
+  const Settings plain = read("newmark_default.toml", with_material(mat)).model.settings;
+  CHECK(plain.trapezoidal());
+  const Settings damped = read("newmark_gamma.toml", with("newmark_gamma = 0.6")).model.settings;
+  CHECK(damped.newmark_gamma == 0.6);
+  CHECK(damped.newmark_beta == Approx(0.3025).epsilon(1e-15));
+  CHECK_THROWS_WITH(read("newmark_low.toml", with("newmark_gamma = 0.4")),
+                    Catch::Contains("solid.newmark_gamma") && Catch::Contains("0.4") &&
+                        Catch::Contains("newmark_low.toml"));
+  CHECK_THROWS_WITH(read("newmark_beta.toml", with("newmark_gamma = 0.8\nnewmark_beta = 0.3")),
+                    Catch::Contains("solid.newmark_beta") && Catch::Contains("0.3") &&
+                        Catch::Contains("at least newmark_gamma / 2") &&
+                        Catch::Contains("newmark_beta.toml"));
+}
+
 TEST_CASE("bad elastic constants name the key, the value and the file", "[config][input]") {
   CHECK_THROWS_WITH(
       read("nu_half.toml", with_material("density = 1\nyoungs_modulus = 1\npoisson_ratio = 0.5\n")),

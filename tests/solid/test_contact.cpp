@@ -160,6 +160,63 @@ TEST_CASE("a block dropped on a rigid plane bounces without penetration or energ
   CHECK(max_vy_after > 0.1 * -min_vy);  // it comes back up
 }
 
+// With Newmark's damped members the contact force is 2 beta lambda (newmark.cpp): the block's
+// momentum changes by the impulse of gravity and of that force step by step (Eq. 14 summed over
+// the nodes, the internal forces cancelling). What the damped scheme keeps from growing is
+// E + (beta - gamma/2) dt^2/2 a^T M a (a = M^-1 (F - Q)), so the energy E stays below its start
+// plus (beta - gamma/2) dt^2/2 m g^2 (a = g at the start), and ends below the trapezoidal run's.
+TEST_CASE("with gamma > 1/2 a bouncing block keeps its momentum balance and loses energy",
+          "[contact][dynamic]") {
+  const double gamma = 0.6, beta = 0.3025, dt = 1e-3, mass = 10 * 0.4 * 0.2;
+  Model model = dropped_block(Settings{}.newton_max_iterations, Settings{}.step_cutbacks);
+  model.settings.newmark_gamma = gamma;
+  model.settings.newmark_beta = beta;
+  Solver s(model);
+  Solver trapezoidal(dropped_block(Settings{}.newton_max_iterations, Settings{}.step_cutbacks));
+  const Mesh& mesh = s.mesh(0);
+  // Row sums of the consistent mass: rho A / 3 per element node.
+  std::vector<double> nodal(mesh.num_nodes(), 0.0);
+  for (const auto& t : mesh.triangles) {
+    const double* x = mesh.x.data();
+    const double area = 0.5 * std::abs((x[2 * t[1]] - x[2 * t[0]]) * (x[2 * t[2] + 1] - x[2 * t[0] + 1]) -
+                                       (x[2 * t[2]] - x[2 * t[0]]) * (x[2 * t[1] + 1] - x[2 * t[0] + 1]));
+    for (int a = 0; a < 3; ++a) nodal[t[a]] += 10 * area / 3;
+  }
+  auto momentum = [&] {
+    const auto& v = s.velocities(0);
+    double p = 0;
+    for (int n = 0; n < mesh.num_nodes(); ++n) p += nodal[n] * v[2 * n + 1];
+    return p;
+  };
+  auto energy = [](const Solver& x) {
+    return x.kinetic_energy() + x.strain_energy() + x.load_potential();
+  };
+  const double e0 = energy(s);
+  double worst_balance = 0, max_energy = e0, contact_impulse = 0, worst_gap = 0;
+  for (int k = 0; k < 300; ++k) {
+    const double p0 = momentum();
+    s.advance(dt);
+    trapezoidal.advance(dt);
+    double fy = 0;
+    const auto& fc = s.contact_forces(0);
+    for (std::size_t d = 1; d < fc.size(); d += 2) fy += fc[d];
+    contact_impulse += fy * dt;
+    worst_balance = std::max(worst_balance, std::abs(momentum() - p0 - dt * (fy - 10 * mass)));
+    max_energy = std::max(max_energy, energy(s));
+    worst_gap = std::min(worst_gap, s.min_contact_gap());
+  }
+  const double bound = (beta - gamma / 2) * dt * dt / 2 * mass * 10 * 10;
+  INFO("contact impulse " << contact_impulse << ", largest momentum imbalance of a step "
+                          << worst_balance << ", energy " << e0 << " -> max " << max_energy
+                          << " (bound " << e0 + bound << "), end " << energy(s)
+                          << " (trapezoidal " << energy(trapezoidal) << "), gap " << worst_gap);
+  CHECK(contact_impulse > 0.5 * mass * std::sqrt(2 * 10 * 0.05));  // it did hit the plane
+  CHECK(worst_balance <= 1e-9 * mass);
+  CHECK(max_energy <= e0 + bound + 1e-9 * mass * 10 * 0.05);
+  CHECK(energy(s) < energy(trapezoidal));
+  CHECK(worst_gap >= -1e-8 * 0.4);
+}
+
 TEST_CASE("a step that fails whole is taken as two half steps, with their mean contact force",
           "[contact][dynamic]") {
   // With 4 Newton iterations some steps of 4e-3 fail (Newton converges, but not within 4),

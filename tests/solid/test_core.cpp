@@ -265,6 +265,43 @@ TEST_CASE("the predictor takes the coupling force's step: no Newton solve", "[ne
   CHECK(solves == 0);
 }
 
+// Newmark's damped members keep a uniform acceleration exact (Eq. 13-14 integrate a constant a
+// exactly for any beta, gamma): a free body under gravity g and pushed by a coupling force
+// F_c = M g' (an impulse over each step) moves as y = (g + g') t^2 / 2, v = (g + g') t, which
+// needs the residual's weights of (M a)^n and F_c and the velocity update's M^-1 terms.
+TEST_CASE("Newmark with gamma > 1/2 keeps a uniform acceleration exact", "[newton]") {
+  for (const double gamma : {0.6, 0.9}) {
+    Model model = free_block(Predictor::none);
+    model.settings.gravity = {0, -10};
+    model.settings.newmark_gamma = gamma;
+    model.settings.newmark_beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
+    model.settings.newton_tolerance = 1e-13;
+    Solver s(model);
+    const Mesh& mesh = s.mesh(0);
+    const double g = -3.0, rho = neo().density;
+    std::vector<std::vector<double>> f(1, std::vector<double>(2 * mesh.num_nodes(), 0.0));
+    for (const auto& t : mesh.triangles) {
+      const double* x = mesh.x.data();
+      const double area = 0.5 * std::abs((x[2 * t[1]] - x[2 * t[0]]) * (x[2 * t[2] + 1] - x[2 * t[0] + 1]) -
+                                         (x[2 * t[2]] - x[2 * t[0]]) * (x[2 * t[1] + 1] - x[2 * t[0] + 1]));
+      for (int a = 0; a < 3; ++a) f[0][2 * t[a] + 1] += rho * area / 3 * g;
+    }
+    const double dt = 1e-3;
+    const int steps = 20;
+    for (int k = 0; k < steps; ++k) s.advance(dt, &f);
+    const double t = steps * dt, a = -10 + g;
+    const std::vector<double> u = s.displacements(0), v = s.velocities(0);
+    double worst_u = 0, worst_v = 0;
+    for (std::size_t d = 0; d < u.size(); ++d) {
+      worst_u = std::max(worst_u, std::abs(u[d] - (d % 2 ? 0.5 * a * t * t : 0.0)));
+      worst_v = std::max(worst_v, std::abs(v[d] - (d % 2 ? a * t : 0.0)));
+    }
+    INFO("gamma " << gamma << ": largest error in u " << worst_u << ", in v " << worst_v);
+    CHECK(worst_u <= 1e-12);
+    CHECK(worst_v <= 1e-10);
+  }
+}
+
 TEST_CASE("a body with rho_s = rho_f has no FE mass and still solves quasi-statically", "[mass]") {
   Model model;
   model.settings.fluid_density = 2.0;  // equal to the solid density

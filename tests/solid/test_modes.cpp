@@ -2,6 +2,7 @@
 // plane-strain modulus, and the same frequency from a free-vibration time run.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <utility>
 
 #include "solver.hpp"
 
@@ -88,4 +89,58 @@ TEST_CASE("modes need inertia", "[modes][input]") {
   Solver s(model);
   CHECK_THROWS_WITH(s.modes(2),
                     Catch::Contains("positive inertial density") && Catch::Contains("'beam'"));
+}
+
+// Newmark's damped members (gamma > 1/2, beta = (gamma + 1/2)^2 / 4): a free vibration from the
+// first mode shape is a one-dof oscillator x'' + omega^2 x = 0 in the mode's coordinate, so its
+// energy after k steps is the one of the one-dof Newmark recurrence (Eq. 13-14 with
+// a = -omega^2 x) from the same start, which the step must follow to round-off and the
+// linearisation of the small amplitude.
+TEST_CASE("Newmark with gamma > 1/2 damps a modal vibration as the one-dof recurrence does",
+          "[modes][dynamic]") {
+  // (1/2, 0.3): the general velocity update without damping; then two damped members.
+  for (const auto& [gamma, beta] : {std::pair{0.5, 0.3}, std::pair{0.6, 0.3025},
+                                    std::pair{0.8, 0.4225}}) {
+    Model model = cantilever(4);
+    model.settings.newmark_gamma = gamma;
+    model.settings.newmark_beta = beta;
+    model.settings.newton_tolerance = 1e-13;
+    Solver s(model);
+    const Modes m = s.modes(1);
+    const double omega = m.omega[0];
+    const int steps_per_period = 10;
+    const double dt = 2 * pi / omega / steps_per_period;
+    // Unit modal velocity scaled to a tip speed of 1e-6 omega (the linear regime).
+    std::vector<double> v = m.shapes[0][0];
+    double vmax = 0;
+    for (double c : v) vmax = std::max(vmax, std::abs(c));
+    const double scale = 1e-6 * omega / vmax;
+    for (double& c : v) c *= scale;
+    s.set_velocity(0, v);
+    const double e0 = s.kinetic_energy() + s.strain_energy();
+    // The one-dof recurrence in the mode's coordinate q (unit modal mass).
+    double q = 0, qd = scale, qdd = 0;
+    const double w2 = omega * omega;
+    double worst = 0, ratio = 1;
+    for (int k = 0; k < 3 * steps_per_period; ++k) {
+      s.advance(dt);
+      const double q1 = (q + dt * qd + dt * dt * (0.5 - beta) * qdd) / (1 + beta * dt * dt * w2);
+      const double qdd1 = -w2 * q1;
+      qd += dt * ((1 - gamma) * qdd + gamma * qdd1);
+      q = q1, qdd = qdd1;
+      const double expected = 0.5 * (qd * qd + w2 * q * q);
+      ratio = expected / e0;
+      const double e = s.kinetic_energy() + s.strain_energy();
+      worst = std::max(worst, std::abs(e / expected - 1));
+    }
+    INFO("gamma " << gamma << ", beta " << beta << ": energy after 3 periods " << ratio
+                  << " of the start in the recurrence, largest relative difference " << worst);
+    // The recurrence itself: gamma = 1/2 keeps the amplitude, the others damp (so the case
+    // compares a decay, not a constant).
+    if (gamma == 0.5)
+      CHECK(std::abs(ratio - 1) <= 0.05);
+    else
+      CHECK(ratio < 0.9);
+    CHECK(worst <= 1e-6);
+  }
 }
