@@ -31,7 +31,10 @@ contact between them.
   and the substeps' CFL number to 0.5, below AB2's limit for it), every output under
   OUT/upwind3. --predictor: the solid's Newton starts each step without active contact at the
   trapezoidal step taken with the forces of the step's start (solid.predictor = "acceleration";
-  solid/README.md), every output under OUT/predictor.
+  solid/README.md), every output under OUT/predictor. --newmark-gamma G: the solid's Newmark step
+  with gamma = G and beta = (G + 1/2)^2 / 4 instead of the scene's 0.55 (solid.newmark_gamma;
+  solid/README.md, "Newmark's parameters"; 0.5 is the paper's trapezoidal rule), every output
+  under OUT/gamma-G.
 With no option (`./fsi validate vocal-folds`): --modes, --short and --sweep."""
 import fcntl
 import json
@@ -89,6 +92,9 @@ P.add_argument("--convection", choices=("central", "upwind3"), default="central"
 P.add_argument("--predictor", action="store_true",
                help="the solid's Newton starts at the trapezoidal step of the step's start forces "
                     "(solid.predictor = \"acceleration\")")
+P.add_argument("--newmark-gamma", type=float, metavar="G", default=None,
+               help="the solid's Newmark gamma instead of the scene's 0.55 (solid.newmark_gamma; "
+                    "beta = (G + 1/2)^2 / 4; 0.5: the paper's trapezoidal rule)")
 P.add_argument("--checkpoint-interval", type=cli.positive, metavar="T", default=None,
                help="the coupled runs write a checkpoint every T")
 ARGS = P.parse_args()
@@ -105,7 +111,8 @@ for sub in (None if ARGS.material == "saint-venant-kirchhoff" else ARGS.material
             None if ARGS.substeps is None else f"substeps-{ARGS.substeps}",
             None if ARGS.cover_size is None else f"cover-{ARGS.cover_size:g}",
             "upwind3" if UPWIND3 else None,
-            "predictor" if ARGS.predictor else None):
+            "predictor" if ARGS.predictor else None,
+            None if ARGS.newmark_gamma is None else f"gamma-{ARGS.newmark_gamma:g}"):
     if sub:
         OUT = job.OUT = os.path.join(OUT, sub)
         os.makedirs(OUT, exist_ok=True)
@@ -182,6 +189,8 @@ bodies = ["upper"]
         text = text.replace("newton_max_iterations = 30", f"newton_max_iterations = 30\nmodes = {modes}")
     if ARGS.predictor and fluid:
         text = text.replace("newton_max_iterations = 30", 'newton_max_iterations = 30\npredictor = "acceleration"')
+    if ARGS.newmark_gamma is not None:
+        text = text.replace("newmark_gamma = 0.55", f"newmark_gamma = {ARGS.newmark_gamma!r}")
     return text
 
 
