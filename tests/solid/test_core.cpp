@@ -207,6 +207,18 @@ Model free_block(Predictor predictor) {
   model.bodies = {b};
   return model;
 }
+// F_c = M g' in y: the consistent mass's row sums (rho A / 3 per element node) times g', the
+// force that gives a free body the uniform acceleration g'.
+std::vector<double> uniform_push(const Mesh& mesh, double rho, double g) {
+  std::vector<double> f(2 * mesh.num_nodes(), 0.0);
+  const double* x = mesh.x.data();
+  for (const auto& t : mesh.triangles) {
+    const double area = 0.5 * std::abs((x[2 * t[1]] - x[2 * t[0]]) * (x[2 * t[2] + 1] - x[2 * t[0] + 1]) -
+                                       (x[2 * t[2]] - x[2 * t[0]]) * (x[2 * t[1] + 1] - x[2 * t[0] + 1]));
+    for (int a = 0; a < 3; ++a) f[2 * t[a] + 1] += rho * area / 3 * g;
+  }
+  return f;
+}
 }  // namespace
 
 // The predictor (newmark.cpp, Solver::predict) is the trapezoidal step with the start's forces:
@@ -243,14 +255,8 @@ TEST_CASE("the predictor takes a free fall as the step: no Newton solve", "[newt
 TEST_CASE("the predictor takes the coupling force's step: no Newton solve", "[newton]") {
   Solver s(free_block(Predictor::acceleration));
   const Mesh& mesh = s.mesh(0);
-  const double g = -3.0, rho = neo().density;
-  std::vector<std::vector<double>> f(1, std::vector<double>(2 * mesh.num_nodes(), 0.0));
-  for (const auto& t : mesh.triangles) {
-    const double* x = mesh.x.data();
-    const double area = 0.5 * std::abs((x[2 * t[1]] - x[2 * t[0]]) * (x[2 * t[2] + 1] - x[2 * t[0] + 1]) -
-                                       (x[2 * t[2]] - x[2 * t[0]]) * (x[2 * t[1] + 1] - x[2 * t[0] + 1]));
-    for (int a = 0; a < 3; ++a) f[0][2 * t[a] + 1] += rho * area / 3 * g;
-  }
+  const double g = -3.0;
+  const std::vector<std::vector<double>> f{uniform_push(mesh, neo().density, g)};
   const double dt = 1e-3;
   const int steps = 20;
   long solves = 0;
@@ -278,14 +284,8 @@ TEST_CASE("Newmark with gamma > 1/2 keeps a uniform acceleration exact", "[newto
     model.settings.newton_tolerance = 1e-13;
     Solver s(model);
     const Mesh& mesh = s.mesh(0);
-    const double g = -3.0, rho = neo().density;
-    std::vector<std::vector<double>> f(1, std::vector<double>(2 * mesh.num_nodes(), 0.0));
-    for (const auto& t : mesh.triangles) {
-      const double* x = mesh.x.data();
-      const double area = 0.5 * std::abs((x[2 * t[1]] - x[2 * t[0]]) * (x[2 * t[2] + 1] - x[2 * t[0] + 1]) -
-                                         (x[2 * t[2]] - x[2 * t[0]]) * (x[2 * t[1] + 1] - x[2 * t[0] + 1]));
-      for (int a = 0; a < 3; ++a) f[0][2 * t[a] + 1] += rho * area / 3 * g;
-    }
+    const double g = -3.0;
+    const std::vector<std::vector<double>> f{uniform_push(mesh, neo().density, g)};
     const double dt = 1e-3;
     const int steps = 20;
     for (int k = 0; k < steps; ++k) s.advance(dt, &f);
