@@ -510,8 +510,9 @@ print("      pairs: footprint 1.38, 1.34, 1.23 against 1.77, 1.27, 1.20 ms, with
 print("      thread instead of two: 1.68, 1.55, 1.48 against 1.22, 1.23, 1.21 ms (two stay)")
 print("  Newmark gamma = 0.55 in the scene (damps the cover's element-scale vibration, which the")
 print("      trapezoidal rule kept) | fewer Newton iterations and cut steps | to t = 12 alone: 1 218")
-print("      -> 1 091 s (5.07 -> 4.55 ms per step; solid 1.89 -> 1.56 ms, Newton 3.46 -> 3.11 per")
-print("      step, 4 -> 1 steps cut; CPU 2 404 -> 2 091 s); a new trajectory (67 closures, 5.74)")
+print("      -> 1 091 s (5.07 -> 4.55 ms per step; solid 1.89 -> 1.56, footprint 1.35 -> 1.24, fluid")
+print("      1.65 -> 1.59 ms; Newton 3.46 -> 3.11 per step, 4 -> 1 steps cut; CPU 2 404 -> 2 091 s);")
+print("      a new trajectory (67 closures, 5.74)")
 PY
 }
 

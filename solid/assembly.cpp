@@ -221,7 +221,8 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
 // The fibers' root inertia (the coupler's root_mass: a 2 x 2 block m per node of the edges that
 // hold roots): the root loads in the coupling force come without it, and the node carries
 // -m a^(n+1), with a^(n+1) = (v^(n+1) - v^n) / dt the node's acceleration over the step, as an
-// impulse like the coupling force (weight s_d, 2 on dofs with mass). With
+// impulse like the coupling force (weight s_d, 2 on dofs with mass; the trapezoidal rule only:
+// advance() refuses root masses with other Newmark parameters). With
 // v_c^(n+1) = s_c (x_c^(n+1) - x_c^n) / dt - [mass] v_c^n,
 //   r_d -= s_d / dt sum_c m_dc (v_c^(n+1) - v_c^n),   K_dc += s_d s_c / dt^2 m'_dc
 // (c over the node's two dofs): on a dof with mass exactly the Newmark inertia of a point mass m.

@@ -92,7 +92,7 @@ struct ContactPlane {
 enum class Analysis { dynamic, statics };
 
 // Where a dynamic step's Newton starts (newmark.cpp, Solver::predict): at x^n, or at the
-// trapezoidal step taken with the acceleration of the step's start.
+// Newmark step taken with the acceleration of the step's start.
 enum class Predictor { none, acceleration };
 
 // Halvings of a failed step at most (Settings::step_cutbacks): dt / 1024, and at most 2^10 parts

@@ -237,20 +237,20 @@ void Solver::initial_acceleration(double dt) {
 // The predictor. The step's start is kept (x^n, v^n), the rigid bodies are moved to t^(n+1), the
 // prescribed displacements at t^(n+1) wait as an increment for the first solve, and the
 // self-contact remembers what each node faces at x^n. Then, with settings.predictor =
-// "acceleration", the elastic bodies' free dofs with mass move to the trapezoidal step taken
-// with the forces of the step's start: in the residual (assembly.cpp) put
+// "acceleration", the elastic bodies' free dofs with mass move to the Newmark step taken with
+// the forces of the step's start (a^(n+1) = a^n): in the residual (assembly.cpp) put
 // (F - Q)^(n+1) = (F - Q)^n = (M a)^n and keep this step's coupling force F_c; no contact (no
 // slot is active at the start). Eq. 13 with a^(n+1) = a^n gives, for any beta,
 //   x = x^n + dt v^n + (dt^2 / 2) M^-1 ((M a)^n + F_c)
 // (in the trapezoidal residual: (4/dt^2) M (x - x^n - dt v^n) = 2 ((M a)^n + F_c)),
 // M the consistent mass on the free equations (factorize_mass; a lumped one leaves the rough
 // part of the fluid's force in the first residual). Newton's first residual is then the change
-// of F - Q over the step, not the step's whole inertia (4/dt) M v^n (solid/README.md, "The
+// of F - Q over the step, not the step's whole inertia M v^n / (beta dt) (solid/README.md, "The
 // predictor"). Dofs that share an equation (periodic partners) move together; massless ones
 // (rho_s = rho_f: quasi-static) start at x^n. Not when a contact slot is active at the start
 // (the contact force is the one part that changes sign within a step: a predicted node would be
 // driven into the surface that stopped it), not in a step with a prescribed increment (a motion
-// the trapezoidal step does not know of: the first solve applies it), not with fibers' root
+// the Newmark step does not know of: the first solve applies it), not with fibers' root
 // masses (the step's mass there is M + m_root, which M^-1 leaves out), nor when a term is not
 // finite (Newton's first residual then names the cause). The coupled iterations' linearised
 // reaction is left out (it vanishes at a converged iteration). Where the look-ahead's factor
@@ -297,7 +297,9 @@ void Solver::predict(double t1, double dt, const std::vector<std::vector<double>
 }
 
 // The mass matrix of the inertia (density rho_s - rho_f, as in the residual) on the free
-// equations, its lower triangle factorised once for the predictor. An equation without mass
+// equations, its lower triangle factorised once (when the solver is built, for the predictor
+// and for the velocity update of Newmark parameters other than the trapezoidal rule's, whose
+// runs stop when it fails). An equation without mass
 // (rho_s = rho_f) gets the mean diagonal of the others (no force: it does not move). False, with
 // a note, when it cannot be factorised.
 bool Solver::factorize_mass() {
@@ -314,10 +316,9 @@ bool Solver::factorize_mass() {
     if (double& d = mass.valuePtr()[matrix_index(e, e)]; !(d > 0)) d = placeholder;
   m_mass_solver.analyze(mass);
   m_mass_state = m_mass_solver.factorize(mass) ? 1 : -1;
-  if (m_mass_state < 0)
+  if (m_mass_state < 0 && m_model.settings.predictor == Predictor::acceleration)
     std::fprintf(stderr, "[solid] note: the mass matrix is singular: solid.predictor = "
-                         "\"acceleration\" is off for this run, and newmark_gamma > 0.5 stops "
-                         "at its first step\n");
+                         "\"acceleration\" is off for this run\n");
   return m_mass_state > 0;
 }
 
@@ -347,9 +348,9 @@ void Solver::update_velocity(double dt) {
   Eigen::VectorXd accel;
   if (!st.trapezoidal()) {
     if (!factorize_mass())
-      fsi::fail("solid.newmark_gamma = {}: the velocity update needs the mass matrix, which is "
-                "singular; use the trapezoidal rule (newmark_gamma = 0.5)",
-                st.newmark_gamma);
+      fsi::fail("solid.newmark_gamma = {}, newmark_beta = {}: the velocity update needs the mass "
+                "matrix, which is singular; remove both keys (the trapezoidal rule)",
+                st.newmark_gamma, st.newmark_beta);
     Eigen::VectorXd force = Eigen::VectorXd::Zero(m_neq);
     for (const auto& bp : m_bodies) {
       const Body& B = *bp;

@@ -99,7 +99,8 @@ class Solver {
   // Coupled iterations: iteration_velocity[b] (may be null or empty per body) is the velocity
   // w at t + dt whose footprint the fluid's forcing used for `external`. When the scene has a
   // fluid (settings.fluid_density > 0) the step linearises the reaction about it (assembly.cpp):
-  // a term that vanishes when the step returns v^(n+1) = w.
+  // a term that vanishes when the step returns v^(n+1) = w. Trapezoidal rule only: with other
+  // Newmark parameters a step with these (or with root masses, below) throws.
   //
   // Fiber roots: root_mass[b] (may be null or empty per body) holds the fibers' root inertia,
   // a 2 x 2 block (m_xx, m_xy, m_yy) per node; the node then carries -m a^(n+1) with its own
@@ -303,7 +304,7 @@ class Solver {
   bool m_keep_allowed = false;
   bool m_keep_factor = false;
   bool m_keep_permitted = true;  // allow_kept_factor
-  double m_matrix_c0 = 0;        // the inertia factor 4/dt^2 of the last matrix assembled
+  double m_matrix_c0 = 0;        // the inertia factor c0 (newmark_c0) of the last matrix
   double m_factored_c0 = 0;      // ... and of the matrix factorised
   bool m_matrix_curved = false;    // the matrix holds contact curvature (add_contact_curvature)
   bool m_factored_curved = false;  // ... and the matrix factorised

@@ -30,7 +30,7 @@ contact between them.
   upwind convection outside the sponge (fluid.convection; the blend --upwind then defaults to 0
   and the substeps' CFL number to 0.5, below AB2's limit for it), every output under
   OUT/upwind3. --predictor: the solid's Newton starts each step without active contact at the
-  trapezoidal step taken with the forces of the step's start (solid.predictor = "acceleration";
+  Newmark step taken with the forces of the step's start (solid.predictor = "acceleration";
   solid/README.md), every output under OUT/predictor. --newmark-gamma G: the solid's Newmark step
   with gamma = G and beta = (G + 1/2)^2 / 4 instead of the scene's 0.55 (solid.newmark_gamma;
   solid/README.md, "Newmark's parameters"; 0.5 is the paper's trapezoidal rule), every output
@@ -90,7 +90,7 @@ P.add_argument("--cover-size", type=cli.positive, metavar="LC", default=None,
 P.add_argument("--convection", choices=("central", "upwind3"), default="central",
                help="the fluid's convection outside the sponge (fluid.convection)")
 P.add_argument("--predictor", action="store_true",
-               help="the solid's Newton starts at the trapezoidal step of the step's start forces "
+               help="the solid's Newton starts at the Newmark step of the step's start forces "
                     "(solid.predictor = \"acceleration\")")
 P.add_argument("--newmark-gamma", type=float, metavar="G", default=None,
                help="the solid's Newmark gamma instead of the scene's 0.55 (solid.newmark_gamma; "
