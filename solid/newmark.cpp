@@ -87,10 +87,7 @@ StepReport Solver::advance(double dt, const std::vector<std::vector<double>>* ex
   if (!m_model.settings.trapezoidal()) {
     // The linearised reaction of coupled iterations and the fibers' root inertia are written for
     // the trapezoidal rule's velocity (assembly.cpp, Body::step_velocity).
-    bool root_masses = false;
-    if (root_mass)
-      for (const auto& m : *root_mass)
-        for (double v : m) root_masses = root_masses || v != 0;
+    const bool root_masses = any_root_mass(root_mass);
     if (m_iteration_velocity || root_masses) {
       m_iteration_velocity = nullptr;
       m_root_mass = nullptr;
@@ -263,10 +260,7 @@ void Solver::predict(double t1, double dt, const std::vector<std::vector<double>
   update_rigid(t1);
   const bool prescribed_increment = prepare_prescribed(t1);
   remember_fronts();
-  bool root_masses = false;
-  if (m_root_mass)
-    for (const auto& m : *m_root_mass)
-      for (double v : m) root_masses = root_masses || v != 0;
+  const bool root_masses = any_root_mass(m_root_mass);
   if (m_model.settings.predictor != Predictor::acceleration || m_predictor_off ||
       any_contact_active() ||
       prescribed_increment || root_masses)

@@ -185,15 +185,12 @@ void SolidProgram::advance(const fsi::proto::StepBegin& sb, const fsi::proto::So
                 "was not told to keep (may_repeat = 0)", sb.step);
     m_solver->restore_state(m_start);
   }
-  if (!m_cfg.model.settings.trapezoidal())
-    for (const auto& m : in.root_mass)
-      for (double v : m)
-        if (v != 0)
-          throw fsi::InputError(fmt::format(
-              "solid.newmark_gamma = {}, newmark_beta = {}: a fiber is rooted on an elastic body, "
-              "whose root inertia is written for the trapezoidal rule; remove both keys (in {})",
-              m_cfg.model.settings.newmark_gamma, m_cfg.model.settings.newmark_beta,
-              m_rt.scene().file().string()));
+  if (!m_cfg.model.settings.trapezoidal() && Solver::any_root_mass(&in.root_mass))
+    throw fsi::InputError(fmt::format(
+        "solid.newmark_gamma = {}, newmark_beta = {}: a fiber is rooted on an elastic body, "
+        "whose root inertia is written for the trapezoidal rule; remove both keys (in {})",
+        m_cfg.model.settings.newmark_gamma, m_cfg.model.settings.newmark_beta,
+        m_rt.scene().file().string()));
   try {
     if (m_cfg.model.settings.analysis == Analysis::statics) {
       // A static analysis walks the load factor t / t_end over the scene's steps.

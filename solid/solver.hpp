@@ -105,6 +105,14 @@ class Solver {
   // Fiber roots: root_mass[b] (may be null or empty per body) holds the fibers' root inertia,
   // a 2 x 2 block (m_xx, m_xy, m_yy) per node; the node then carries -m a^(n+1) with its own
   // acceleration over the step (assembly.cpp, add_root_mass).
+  // Whether root masses (advance()'s root_mass, may be null) hold a non-zero value.
+  static bool any_root_mass(const std::vector<std::vector<double>>* root_mass) {
+    if (root_mass)
+      for (const auto& m : *root_mass)
+        for (double v : m)
+          if (v != 0) return true;
+    return false;
+  }
   StepReport advance(double dt, const std::vector<std::vector<double>>* external = nullptr,
                      const std::vector<std::vector<double>>* iteration_velocity = nullptr,
                      const std::vector<std::vector<double>>* root_mass = nullptr);
