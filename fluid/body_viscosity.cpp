@@ -25,7 +25,10 @@ namespace fluid {
 // takes the same correction before its solve; the solve's ½ ν Δt L₀ (ũ − uⁿ) is left inside the
 // body, O(Δt).
 //
-// F holds the prediction (ũ or û); uⁿ is m_un, m_vn. One rank only (checked at set-up).
+// F holds the prediction (ũ or û); uⁿ is m_un, m_vn. On several ranks each rank has its own
+// rows' faces in the coupling input; the α of the ghost rows (a stencil reads one row beyond the
+// slab) come from the neighbours by a halo exchange, uⁿ's ghost rows are the step's. A periodic y
+// on several ranks is refused at set-up (the wrap would read rows the slab does not hold).
 void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
   if (!m_cfg.bodies_inviscid) return;
   const int nx = m_grid.nx(), ny = m_grid.ny();
@@ -44,7 +47,7 @@ void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
   auto wrap = [](int k, int n, bool periodic) { return periodic ? (k + n) % n : k; };
   // α of face (i, j) of family c for the minima: 1 (no say) beyond a wall or on a boundary face.
   auto a_at = [&](int c, int i, int j) {
-    i = wrap(i, ni[c], px), j = wrap(j, nj[c], py);
+    i = wrap(i, ni[c], px), j = wrap(j, nj[c], py);  // (py only on one rank)
     if (i < i_lo[c] || i >= i_hi[c] || j < j_lo[c] || j >= j_hi[c]) return 1.0;
     return m_body_alpha[c](i, j);
   };
@@ -54,6 +57,8 @@ void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
       double& a = m_body_alpha[c](i, j);
       a = std::min(1.0, a + alpha[c][q]);
     }
+  m_dec.halo(m_body_alpha[0]);
+  m_dec.halo(m_body_alpha[1]);
   const Field& U = m_un;
   const Field& V = m_vn;
   // φ at the corner (x face i, y face j): u faces (i, j − 1), (i, j); v faces (i − 1, j), (i, j).
@@ -90,13 +95,19 @@ void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
       F(i, j) -= dt * m_nu * d;
     }
   }
-  // Back to zero for the next step (the footprint moves).
-  for (int c = 0; c < 2; ++c)
+  // Back to zero for the next step (the footprint moves), the ghost rows the halo filled too.
+  for (int c = 0; c < 2; ++c) {
     for (std::size_t q = 0; q < idx[c].size(); ++q) {
       const auto [i, j] = face_of(c, idx[c][q]);
       m_body_alpha[c](i, j) = 0;
       m_body_mark[c][std::size_t(i) + std::size_t(ni[c]) * j] = 0;
     }
+    if (!m_dec.serial()) {
+      Field& A = m_body_alpha[c];
+      std::fill(A.row(A.jlo - 1) - 1, A.row(A.jlo - 1) + A.ni + 1, 0.0);
+      std::fill(A.row(A.jhi) - 1, A.row(A.jhi) + A.ni + 1, 0.0);
+    }
+  }
 }
 
 }  // namespace fluid
