@@ -434,7 +434,7 @@ bench_vocal_folds() {
   # steps (runs/vocal-folds/README.md).
   say "vocal folds at h = 0: contact, wall planes, substeps"
   FSI_OUT="$ROOT/out/bench/vocal-folds-contact" FSI_BIN="$BIN" /usr/bin/python3 \
-    "$ROOT/runs/vocal-folds/validate.py" --run 0 --grid paper --t-end 0.25 --upwind 0.2 \
+    "$ROOT/runs/vocal-folds/validate.py" --run 0 --grid paper --t-end 0.25 --upwind 0.2 --convection central \
     --material neo-hookean --wall-planes --substeps 4 > /dev/null ||
     die "the vocal folds' contact bench failed (out/bench/vocal-folds-contact)"
   /usr/bin/python3 "$ROOT/runs/bench-vocal-folds/report.py" \

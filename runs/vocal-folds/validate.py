@@ -2,40 +2,47 @@
 """Vocal folds (paper Sec. 5.1): two mirrored two-layer M5 folds in a channel, frictionless
 contact between them.
 
+The coupled runs use the set-up validated in README.md unless told otherwise: neo-Hookean folds,
+a contact plane at each wall, the fluid sub-cycled (up to 4 substeps), third-order upwind
+convection, the scene's Newmark gamma = 0.55. The paper's own choices, which do not run through
+the closures (README), are one option each: --material saint-venant-kirchhoff,
+--no-wall-planes, --substeps 0, --convection central (with --upwind 0.2, the blend that keeps
+central convection stable in the jet), --newmark-gamma 0.5.
+
 --modes: the first three eigenfrequencies and mode shapes of one fold (paper Eq. 28; the paper
   finds 1.85, 4.12, 5.45 for its geometry) and of the pair, the pair's modes as mirror-symmetric
   and antisymmetric combinations; modes.png.
 --short: h = 0 (the folds touch at t = 0) on a coarse grid through the first contact episodes;
   fails when contact in the flow breaks (Newton, penetration) or the run stops.
---run H: one coupled run at clearance h/D = H (--grid paper|coarse, --t-end T (default 10),
+--run H: one coupled run at clearance h/D = H (--grid paper|coarse, --t-end T (default 12),
   --impulsive: no inflow ramp, --upwind B, --p-sub P: a pressure inlet).
 --sweep: the clearance sweep (paper Sec. 5.1): h = 0, 0.01, 0.02, 0.04, 0.05 with the velocity
   inflow and h = 0 with a pressure inlet (P = 5000), on --grid (default paper) to --t-end
-  (default 6) with --upwind (default 0.2); with --modes. A run of the identical scene already
-  there is used (finished, failed with an ERROR in its log, or still running: what it wrote so
-  far), the others are run (--no-run: none is). Per run: point B's u_y, its spectrum over
-  t >= 1, the dominant frequency and the nearest eigenfrequency, the amplitude, contact, forces
-  and impulses; spectra.png (Fig. 13), frequency.png, trajectories.png (Fig. 14), forces_h0.png
-  (Fig. 15), fields.png (Fig. 12); the paper's findings reported, only "ran to t_end" judged.
---material neo-hookean: the folds' cover and body neo-Hookean with the same small-strain E and nu
-  (the paper: St.Venant-Kirchhoff, which loses its stiffness under strong compression; README),
-  every output under OUT/neo-hookean. --clearances H,H,...: the sweep's velocity-inflow runs at
-  these clearances only (and no pressure-inlet run). --dt DT: the coupled runs' time step (the
-  paper's 5e-5 by default), every output under OUT/dt-DT. --wall-planes: each fold kept on its
-  side of its wall by a rigid contact plane ([[solid.plane]]), every output under OUT/planes.
-  --substeps M: the fluid sub-cycles, up to M steps per coupled step at a CFL number of at most
-  0.8 each ([fluid.substeps]; fluid/README.md), every output under OUT/substeps-M.
-  --checkpoint-interval T: the coupled runs write a checkpoint every T (`./fsi run SCENE
-  --restart RUN` resumes one; the outputs are unchanged). --convection upwind3: third-order
-  upwind convection outside the sponge (fluid.convection; the blend --upwind then defaults to 0
-  and the substeps' CFL number to 0.5, below AB2's limit for it), every output under
-  OUT/upwind3. --predictor: the solid's Newton starts each step without active contact at the
-  Newmark step taken with the forces of the step's start (solid.predictor = "acceleration";
-  solid/README.md), every output under OUT/predictor. --newmark-gamma G: the solid's Newmark step
-  with gamma = G and beta = (G + 1/2)^2 / 4 instead of the scene's 0.55 (solid.newmark_gamma;
-  solid/README.md, "Newmark's parameters"; 0.5 is the paper's trapezoidal rule), every output
-  under OUT/gamma-G.
+  (default 12) with --upwind (default 0; 0.2 with --convection central); with --modes. A run of
+  the identical scene already there is used (finished, failed with an ERROR in its log, or still
+  running: what it wrote so far), the others are run (--no-run: none is). Per run: point B's
+  u_y, its spectrum over t >= 1, the dominant frequency and the nearest eigenfrequency, the
+  amplitude, contact, forces and impulses; spectra.png (Fig. 13), frequency.png,
+  trajectories.png (Fig. 14), forces_h0.png (Fig. 15), fields.png (Fig. 12); the paper's
+  findings reported, only "ran to t_end" judged.
+--clearances H,H,...: the sweep's velocity-inflow runs at these clearances only (and no
+  pressure-inlet run).
+Each choice has its own output folder, nested in this order under OUT: --material neo-hookean
+(the default) OUT/neo-hookean; --dt DT (the coupled runs' time step, the paper's 5e-5 by
+default) OUT/dt-DT; --wall-planes (default) OUT/planes ([[solid.plane]]: each fold kept on its
+side of its wall by a rigid contact plane); --substeps M > 0 OUT/substeps-M ([fluid.substeps]:
+up to M fluid steps per coupled step at a CFL number of at most 0.8 each, 0.5 with upwind3;
+fluid/README.md); --cover-size LC OUT/cover-LC; --convection upwind3 (default) OUT/upwind3
+(fluid.convection, outside the sponge); --predictor OUT/predictor (the solid's Newton starts
+each step without active contact at the Newmark step taken with the forces of the step's start,
+solid.predictor = "acceleration"); --newmark-gamma G OUT/gamma-G (the solid's Newmark step with
+gamma = G and beta = (G + 1/2)^2 / 4 instead of the scene's 0.55; solid.newmark_gamma,
+solid/README.md, "Newmark's parameters"; 0.5 is the paper's trapezoidal rule). So the default
+runs are in OUT/neo-hookean/planes/substeps-4/upwind3.
+--checkpoint-interval T: the coupled runs write a checkpoint every T (`./fsi run SCENE --restart
+  RUN` resumes one; the outputs are unchanged).
 With no option (`./fsi validate vocal-folds`): --modes, --short and --sweep."""
+import argparse
 import fcntl
 import json
 import os
@@ -74,21 +81,23 @@ P.add_argument("--sweep", action="store_true",
 P.add_argument("--no-run", action="store_true",
                help="--sweep: start no run, process only the runs that are there")
 P.add_argument("--material", choices=("saint-venant-kirchhoff", "neo-hookean"),
-               default="saint-venant-kirchhoff", help="the folds' material (the paper's by default)")
+               default="neo-hookean",
+               help="the folds' material (default neo-hookean; saint-venant-kirchhoff: the paper's)")
 P.add_argument("--clearances", type=lambda s: [float(v) for v in s.split(",")], default=None,
                help="--sweep: only these clearances, velocity inflow")
-P.add_argument("--wall-planes", action="store_true",
-               help="a rigid contact plane at each wall, for the fold fixed on it")
+P.add_argument("--wall-planes", action=argparse.BooleanOptionalAction, default=True,
+               help="a rigid contact plane at each wall, for the fold fixed on it (default: on)")
 P.add_argument("--dt", type=cli.positive, default=None,
                help="the coupled runs' time step (default: the scene's, the paper's 5e-5)")
-P.add_argument("--substeps", type=int, metavar="M", default=None,
+P.add_argument("--substeps", type=cli.count, metavar="M", default=4,
                help="the fluid up to M substeps per step, each at a CFL number of at most 0.8 "
-                    "(0.5 with --convection upwind3)")
+                    "(0.5 with --convection upwind3); default 4, 0: one fluid step per step")
 P.add_argument("--cover-size", type=cli.positive, metavar="LC", default=None,
                help="the folds' element size within the cover's thickness of the wetted surface "
                     "(fold.geo's lc_cover; default: the element size lc = 0.024 throughout)")
-P.add_argument("--convection", choices=("central", "upwind3"), default="central",
-               help="the fluid's convection outside the sponge (fluid.convection)")
+P.add_argument("--convection", choices=("central", "upwind3"), default="upwind3",
+               help="the fluid's convection outside the sponge (fluid.convection; default upwind3, "
+                    "central: the paper's)")
 P.add_argument("--predictor", action="store_true",
                help="the solid's Newton starts at the Newmark step of the step's start forces "
                     "(solid.predictor = \"acceleration\")")
@@ -108,7 +117,7 @@ OUT = job.out_dir("vocal-folds")
 for sub in (None if ARGS.material == "saint-venant-kirchhoff" else ARGS.material,
             None if ARGS.dt is None else f"dt-{ARGS.dt:g}",
             "planes" if ARGS.wall_planes else None,
-            None if ARGS.substeps is None else f"substeps-{ARGS.substeps}",
+            f"substeps-{ARGS.substeps}" if ARGS.substeps else None,
             None if ARGS.cover_size is None else f"cover-{ARGS.cover_size:g}",
             "upwind3" if UPWIND3 else None,
             "predictor" if ARGS.predictor else None,
@@ -157,7 +166,7 @@ bodies = ["upper"]
         text = text.replace("dt = 5e-5", f"dt = {ARGS.dt!r}")
     if ARGS.checkpoint_interval is not None and fluid:
         text = text.replace("[output]\n", f"[output]\ncheckpoint_interval = {ARGS.checkpoint_interval!r}\n", 1)
-    if ARGS.substeps is not None and fluid:
+    if ARGS.substeps and fluid:
         text += f"\n[fluid.substeps]\nmax = {ARGS.substeps}\ncfl = {SUBSTEPS_CFL}\n"
     text = text.replace("t_end = 10.0", f"t_end = {t_end!r}").replace("interval = 0.05", f"interval = {interval!r}")
     if p_sub is not None:
@@ -298,7 +307,7 @@ def run_name(h, grid, p_sub=None, upwind=None):
 
 if ARGS.run is not None:
     r, err, hist = coupled(run_name(ARGS.run, ARGS.grid, ARGS.p_sub, ARGS.upwind), ARGS.run, ARGS.grid,
-                           ARGS.t_end or 10.0,
+                           ARGS.t_end or 12.0,
                            ramp="none" if ARGS.impulsive else None, p_sub=ARGS.p_sub,
                            upwind=ARGS.upwind)
     print(f"run h = {ARGS.run}: exit {r.returncode}, {err or 'ran to the end'}, wall {r.wall:.0f} s")
@@ -729,7 +738,7 @@ def sweep_plots(rows, modes_f, x_ref, shapes):
 
 
 if ARGS.sweep:
-    t_end, upwind = ARGS.t_end or 6.0, ARGS.upwind if ARGS.upwind is not None else 0.0 if UPWIND3 else 0.2
+    t_end, upwind = ARGS.t_end or 12.0, ARGS.upwind if ARGS.upwind is not None else 0.0 if UPWIND3 else 0.2
     cases = SWEEP_CASES if ARGS.clearances is None else [(h, None) for h in ARGS.clearances]
     rows = [sweep_case(h, p, ARGS.grid, t_end, upwind, f1) for h, p in cases]
     sweep_plots(rows, f1, x_ref, shapes)
