@@ -54,7 +54,7 @@ void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
   for (int c = 0; c < 2; ++c)
     for (std::size_t q = 0; q < idx[c].size(); ++q) {
       const auto [i, j] = face_of(c, idx[c][q]);
-      double& a = m_body_alpha[c](i, j);
+      double& a = m_body_alpha[c](i, owned(j, c));
       a = std::min(1.0, a + alpha[c][q]);
     }
   m_dec.halo(m_body_alpha[0]);

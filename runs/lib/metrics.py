@@ -66,10 +66,11 @@ def _fmt(x, spec=".6g"):
 
 
 def finish(case, metrics, extra=None, short=False, name="summary.json", per_run=None,
-           reference=None):
-    """Write job.OUT/name (metrics, extra, the jobs' wall and CPU time); print each metric; exit
-    1 when a judged metric fails. per_run: run_entry() of each run of a grid or time-step
-    sequence; reference: where the reference values come from (text)."""
+           reference=None, copies=()):
+    """Write job.OUT/name (metrics, extra, the jobs' wall and CPU time), and the same to each
+    path of copies; print each metric; exit 1 when a judged metric fails. per_run: run_entry()
+    of each run of a grid or time-step sequence; reference: where the reference values come
+    from (text)."""
     runs = job.RUNS
     cpu = [r["cpu_s"] for r in runs if r.get("cpu_s") is not None]
     bad = [k for k, m in metrics.items() if m["pass"] is False]
@@ -82,14 +83,16 @@ def finish(case, metrics, extra=None, short=False, name="summary.json", per_run=
         s["reference_source"] = reference
     s.update(extra or {})
     path = os.path.join(job.OUT, name)
-    with open(path, "w") as f:
-        json.dump(s, f, indent=2)
+    for p in [path, *copies]:
+        with open(p, "w") as f:
+            json.dump(s, f, indent=2)
     for k, m in metrics.items():
         verdict = {True: "pass", False: "FAIL", None: "reported"}[m["pass"]]
         print(f"  {k}: {_fmt(m['value'])} (reference {_fmt(m['reference'])}, error "
               f"{_fmt(m['error'], '.3g')}, tolerance {_fmt(m['tolerance'], '.3g')}) {verdict}")
     print(f"{case}: {len(runs)} job(s), wall {s['wall_s']:.1f} s, CPU "
-          f"{_fmt(s['cpu_s'], '.1f')} s; summary in {path}")
+          f"{_fmt(s['cpu_s'], '.1f')} s; summary in {path}" +
+          "".join(f" and {p}" for p in copies))
     if bad:
         print(f"{case}: failed: {', '.join(bad)}")
         sys.exit(1)

@@ -17,6 +17,8 @@ set by TAU instead of dt; fluid/forcing.cpp); runs and the --bands-xy JSON named
 `--helmholtz direct|factored`: fluid.helmholtz in the scenes (factored by default: the key is
 always written, so that --reuse never takes a run of the direct solve for one of the factored);
 runs with the direct solve are named *-direct.
+`--body-viscosity none`: fluid.body_viscosity = "none" in the scenes (the mixture stress on the
+cut faces, fluid/README.md), every output under OUT/body-viscosity-none.
 Environment (set by `./fsi validate`): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN."""
 import glob
 import json
@@ -54,12 +56,17 @@ _p.add_argument("--cases", nargs="+", choices=["cfd1", "cfd2"], default=["cfd1",
                 help="--bands-xy: these cases only")
 _p.add_argument("--helmholtz", choices=["direct", "factored"], default="factored",
                 help="fluid.helmholtz of the scenes (Crank-Nicolson's Helmholtz solves)")
+_p.add_argument("--body-viscosity", choices=["kelvin-voigt", "none"], default=None,
+                help="fluid.body_viscosity of the scenes (default: not given, kelvin-voigt)")
 ARGS = _p.parse_args()
 if ARGS.forcing_time is not None and not ARGS.bands_xy:
     _p.error("--forcing-time goes with --bands-xy (the other modes' files are not named by it)")
 SHORT, REUSE = ARGS.short, ARGS.reuse
 HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = job.out_dir("turek-hron-cfd")
+if ARGS.body_viscosity is not None:
+    OUT = job.OUT = os.path.join(OUT, f"body-viscosity-{ARGS.body_viscosity}")
+    os.makedirs(OUT, exist_ok=True)
 
 H, L = 0.41, 2.5
 TAU_TAG = "" if ARGS.forcing_time is None else f"-tau{ARGS.forcing_time:g}"
@@ -132,6 +139,8 @@ def scene_text(case, n, dt=None, band=None, name=None, x_band=None, columns=None
             line += f'\nhelmholtz = "{ARGS.helmholtz}"'
             if ARGS.forcing_time is not None:
                 line += f"\nforcing_time = {ARGS.forcing_time!r}"
+            if ARGS.body_viscosity is not None:
+                line += f'\nbody_viscosity = "{ARGS.body_viscosity}"'
         lines.append(line)
     assert not replace, f"scene {case}.toml lacks keys {list(replace)}"
     return "\n".join(lines) + "\n", dt

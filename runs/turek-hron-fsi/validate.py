@@ -29,6 +29,8 @@ rho_s = 10 rho_f (only the transient differs).
   validate --smoothing FSI2 on L2 with coupler.footprint_smoothing 0, 0.5 and 1: the forces'
                       grid-crossing jitter against their bias (about 6 min)
   validate --reuse    keep a run whose folder has a summary.json from the identical scene text
+  validate ... --body-viscosity none   every run with [fluid] body_viscosity = "none" (the bar
+                      purely elastic, fluid/README.md), outputs under OUT/body-viscosity-none
 Environment (set by ./fsi validate): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN."""
 import json
 import os
@@ -60,6 +62,8 @@ _p.add_argument("--fsi1-bands-xy", action="store_true", help="FSI1 with bands in
 _p.add_argument("--smoothing", action="store_true",
                 help="FSI2 on L2 with the footprint smoothed (coupler.footprint_smoothing 0, 0.5, 1)")
 _p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
+_p.add_argument("--body-viscosity", choices=("kelvin-voigt", "none"), default=None,
+                help="[fluid] body_viscosity of every run (default: the scenes', kelvin-voigt)")
 ARGS = _p.parse_args()
 # --ci: L2 only, the frequency judged against the refined values and reported against the 2006
 # table's 2.0 Hz, which this method misses by 3.4-3.5 % on every level (README, "Frequency").
@@ -69,6 +73,9 @@ REUSE = ARGS.reuse
 COARSE = ARGS.coarse
 HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = job.out_dir("turek-hron-fsi")
+if ARGS.body_viscosity is not None:
+    OUT = job.OUT = os.path.join(OUT, f"body-viscosity-{ARGS.body_viscosity}")
+    os.makedirs(OUT, exist_ok=True)
 H, L = 0.41, 2.5
 
 # Turek & Hron (2006), Table "FSI2" and "FSI1" (reference.csv, with the source).
@@ -148,6 +155,8 @@ def scene_text(case, level, dt=None, rho_s=None, t_end=None, smoothing=None):
             line = f"density = {rho_s:g}"
         lines.append(line)
     assert not replace, f"scene {case}.toml lacks keys {list(replace)}"
+    if ARGS.body_viscosity is not None:
+        lines.insert(lines.index("[fluid]") + 1, f'body_viscosity = "{ARGS.body_viscosity}"')
     if smoothing is not None:
         k = lines.index("[coupler]")
         lines.insert(k + 1, f"footprint_smoothing = {smoothing:g}")
