@@ -26,9 +26,11 @@ namespace fluid {
 // body, O(Δt).
 //
 // F holds the prediction (ũ or û); uⁿ is m_un, m_vn. On several ranks each rank has its own
-// rows' faces in the coupling input; the α of the ghost rows (a stencil reads one row beyond the
-// slab) come from the neighbours by a halo exchange, uⁿ's ghost rows are the step's. A periodic y
-// on several ranks is refused at set-up (the wrap would read rows the slab does not hold).
+// rows' faces in the coupling input; the α of the rows beyond the slab (a stencil reads one)
+// come from the neighbours by a halo exchange, which overwrites them at every step (a slab's
+// end without a neighbour is never written), as uⁿ's are the step's. With a periodic y the
+// halo brings the rows across the periodic boundary (the first and last ranks are neighbours),
+// so there the rows are read where they are stored instead of wrapped.
 void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
   if (!m_cfg.bodies_inviscid) return;
   const int nx = m_grid.nx(), ny = m_grid.ny();
@@ -46,9 +48,11 @@ void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
   const std::span<const double> alpha[2] = {in.solid_u_alpha, in.solid_v_alpha};
   auto wrap = [](int k, int n, bool periodic) { return periodic ? (k + n) % n : k; };
   // α of face (i, j) of family c for the minima: 1 (no say) beyond a wall or on a boundary face.
+  const bool wrap_y = py && m_dec.serial();
   auto a_at = [&](int c, int i, int j) {
-    i = wrap(i, ni[c], px), j = wrap(j, nj[c], py);  // (py only on one rank)
-    if (i < i_lo[c] || i >= i_hi[c] || j < j_lo[c] || j >= j_hi[c]) return 1.0;
+    i = wrap(i, ni[c], px), j = wrap(j, nj[c], wrap_y);
+    if (i < i_lo[c] || i >= i_hi[c]) return 1.0;
+    if (!py && (j < j_lo[c] || j >= j_hi[c])) return 1.0;
     return m_body_alpha[c](i, j);
   };
   for (int c = 0; c < 2; ++c)
@@ -95,19 +99,13 @@ void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
       F(i, j) -= dt * m_nu * d;
     }
   }
-  // Back to zero for the next step (the footprint moves), the ghost rows the halo filled too.
-  for (int c = 0; c < 2; ++c) {
+  // Back to zero for the next step (the footprint moves).
+  for (int c = 0; c < 2; ++c)
     for (std::size_t q = 0; q < idx[c].size(); ++q) {
       const auto [i, j] = face_of(c, idx[c][q]);
       m_body_alpha[c](i, j) = 0;
       m_body_mark[c][std::size_t(i) + std::size_t(ni[c]) * j] = 0;
     }
-    if (!m_dec.serial()) {
-      Field& A = m_body_alpha[c];
-      std::fill(A.row(A.jlo - 1) - 1, A.row(A.jlo - 1) + A.ni + 1, 0.0);
-      std::fill(A.row(A.jhi) - 1, A.row(A.jhi) + A.ni + 1, 0.0);
-    }
-  }
 }
 
 }  // namespace fluid

@@ -165,12 +165,6 @@ Solver::Solver(const Config& c, double dt, MPI_Comm comm)
     build_implicit(dt);
   }
   if (c.bodies_inviscid) {
-    if (!m_dec.serial() && m_grid.y().periodic())
-      throw fsi::InputError(fmt::format(
-          "fluid.body_viscosity = \"none\" with a periodic y needs the fluid on one rank (it "
-          "reads the volume fractions of the rows across the periodic boundary); set ranks = 1 "
-          "or body_viscosity = \"kelvin-voigt\" (in {})",
-          c.source));
     m_body_alpha = {Field(nx + 1, ny, lo, hi), Field(nx, ny + 1, lo, vhi)};
     m_body_mark = {std::vector<char>(std::size_t(nx + 1) * ny, 0),
                    std::vector<char>(std::size_t(nx) * (ny + 1), 0)};
