@@ -6,6 +6,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <map>
 #include <sstream>
 #include <toml.hpp>
 
@@ -48,6 +49,17 @@ bool may_change(const std::string& path) {
          path == "fluid.ranks";
 }
 
+// Keys whose default changed, so that the effective scene records them from then on: a
+// checkpoint written before holds no such key, and ran as the value given here. A resumed run
+// that sets that value explicitly continues the same physics.
+bool legacy_value(const std::string& path, const Toml& now) {
+  static const std::map<std::string, std::string> kLegacy = {
+      {"fluid.body_viscosity", "kelvin-voigt"},  // the default until the bodies became elastic
+  };
+  const auto it = kLegacy.find(path);
+  return it != kLegacy.end() && now == Toml(it->second);
+}
+
 std::string first_difference(const Toml& a, const Toml& b, const std::string& path) {
   if (!path.empty() && may_change(path)) return {};
   if (a.is_table() && b.is_table()) {
@@ -61,7 +73,7 @@ std::string first_difference(const Toml& a, const Toml& b, const std::string& pa
     }
     for (const auto& [k, v] : b.as_table()) {
       const std::string p = path.empty() ? k : path + "." + k;
-      if (!a.as_table().count(k) && !may_change(p)) return p;
+      if (!a.as_table().count(k) && !may_change(p) && !legacy_value(p, v)) return p;
     }
     return {};
   }

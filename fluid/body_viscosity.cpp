@@ -31,8 +31,16 @@ namespace fluid {
 // end without a neighbour is never written), as uⁿ's are the step's. With a periodic y the
 // halo brings the rows across the periodic boundary (the first and last ranks are neighbours),
 // so there the rows are read where they are stored instead of wrapped.
+//
+// Whether any rank has faces decides, the same on every rank (the halos below are collective);
+// a step whose footprint has faces after a step without any did not keep uⁿ and keeps the
+// viscosity inside the bodies that once (a body entering the grid; bodies there from the start
+// have faces at the first step).
 void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
   if (!m_cfg.bodies_inviscid) return;
+  const bool here = !in.solid_u_index.empty() || !in.solid_v_index.empty();
+  m_body_faces = m_dec.serial() ? here : m_dec.sum(here ? 1.0 : 0.0) > 0;
+  if (!m_body_faces || !m_un_kept) return;
   const int nx = m_grid.nx(), ny = m_grid.ny();
   const bool px = m_grid.x().periodic(), py = m_grid.y().periodic();
   const Axis& X = m_grid.x();

@@ -304,9 +304,7 @@ Config read_config(const fsi::SceneTable& f, double dt) {
                                       "\"implicit\" or remove the key",
                                       c.factored_helmholtz ? "factored" : "direct"));
   }
-  if (f.has("body_viscosity"))
-    c.bodies_inviscid =
-        f.choice("body_viscosity", {"kelvin-voigt", "none"}, "kelvin-voigt") == "none";
+  c.bodies_inviscid = f.choice("body_viscosity", {"none", "kelvin-voigt"}, "none") == "none";
   if (f.has("forcing_time")) {
     c.forcing_time = f.non_negative("forcing_time");
     if (c.implicit && c.forcing_in_increment)

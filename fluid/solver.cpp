@@ -309,8 +309,10 @@ void Solver::begin_step(double dt) {
     const PhaseTimer t(m_time.predictor, m_time.cpu);
     explicit_terms();
   }
-  // u^n with t^n's boundary values and ghosts (predictor_implicit, remove_body_viscosity)
-  if (m_cfg.implicit || m_cfg.bodies_inviscid) {
+  // u^n with t^n's boundary values and ghosts (predictor_implicit; remove_body_viscosity, while
+  // the footprint has faces: a scene without bodies does not pay for the copy)
+  m_un_kept = m_cfg.implicit || (m_cfg.bodies_inviscid && m_body_faces);
+  if (m_un_kept) {
     const PhaseTimer t(m_time.predictor, m_time.cpu);
     m_un = m_u;
     m_vn = m_v;

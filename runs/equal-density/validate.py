@@ -58,7 +58,8 @@ def run(name, text):
 
 
 def two_layer_scene(name, n, rho_s, t_end, iterate):
-    return tl.scene(name, n, 0.5, DT, t_end, rho_s) + (ITERATIONS if iterate else "")
+    return tl.scene(name, n, 0.5, DT, t_end, rho_s, body_viscosity="kelvin-voigt") + \
+        (ITERATIONS if iterate else "")
 
 
 def two_layer_error(folder, rho_s, t_end):

@@ -5,9 +5,10 @@ periodic in x. fluid + solid + coupler as one MPMD job; the x-averaged fluid vel
 the solid's where the forcing holds it) is compared with the exact time-periodic solution over
 the last period, on three grids, with the interface on a grid line and off it.
 The immersed-solid method fills the layer with fluid that the forcing moves with the solid, so
-the fluid's viscous stress mu_f grad(u_s) acts inside the layer as well: the discrete model is a
-Kelvin-Voigt layer with mu_s = mu_f, and the reference is the exact solution of that layer
-(runs/lib/two_layer.py). The purely elastic layer's solution (mu_s = 0) is reported beside it.
+with [fluid] body_viscosity = "kelvin-voigt" (written into these scenes; the fluid's default is
+"none") the fluid's viscous stress mu_f grad(u_s) acts inside the layer as well: the discrete
+model is a Kelvin-Voigt layer with mu_s = mu_f, and the reference is the exact solution of that
+layer (runs/lib/two_layer.py). The purely elastic layer's solution (mu_s = 0) is reported beside it.
 The grids run at dt = 5e-4 (16 / n)^2 on n cells, so that nu dt / h^2 = 0.128 on every grid: the
 Crank-Nicolson forcing's leak (runs/sub-cell-wall), a fixed number of cells at a fixed
 nu dt / h^2, then shrinks with h and the order is the space discretisation's (about 20 min).
@@ -40,7 +41,7 @@ OUT = job.out_dir("two-layer-channel")
 SUFFIX = ("-fixed-dt" if ARGS.fixed_dt else "") + ("-elastic" if ARGS.elastic else "")
 # The layer's model the run asks for, and the viscosity of the exact solution it is held to; the
 # other model's error is reported beside it.
-MODEL = "none" if ARGS.elastic else None
+MODEL = "none" if ARGS.elastic else "kelvin-voigt"
 MU_S, MU_OTHER = (0.0, tl.MU) if ARGS.elastic else (tl.MU, 0.0)
 
 DT = 5e-4

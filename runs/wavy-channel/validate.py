@@ -141,6 +141,7 @@ interval = {INTERVAL}
 density = {RHO_F}
 viscosity = {MU}
 diffusion = "implicit"
+body_viscosity = "kelvin-voigt"
 [fluid.grid]
 cells = [{n}, {n // 2}]
 size = [{L}, {c['H']}]

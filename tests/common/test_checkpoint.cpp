@@ -44,6 +44,22 @@ TEST_CASE("a restart may change t_end, [output] and the description, nothing els
         "fluid.density");
 }
 
+TEST_CASE("a key recorded since its default changed: absent counts as its old value", "[checkpoint]") {
+  using fsi::changed_physics_key;
+  // A checkpoint from before fluid.body_viscosity was recorded ran the bodies as Kelvin-Voigt
+  // solids: the same explicitly continues it, the new default does not.
+  const auto with = [&](const char* v) {
+    return replaced(kScene, "viscosity = 0.01", std::string("viscosity = 0.01\nbody_viscosity = ") + v);
+  };
+  CHECK(changed_physics_key(kScene, with("\"kelvin-voigt\"")).empty());
+  CHECK(changed_physics_key(kScene, with("\"none\"")) == "fluid.body_viscosity");
+  CHECK(changed_physics_key(with("\"none\""), with("\"kelvin-voigt\"")) == "fluid.body_viscosity");
+  CHECK(changed_physics_key(with("\"kelvin-voigt\""), kScene) == "fluid.body_viscosity");
+  // Any other key added at a restart still counts.
+  CHECK(changed_physics_key(kScene, replaced(kScene, "viscosity = 0.01", "viscosity = 0.01\nforcing_time = 0.0")) ==
+        "fluid.forcing_time");
+}
+
 TEST_CASE("the restart takes the newest step every program completed", "[checkpoint]") {
   const auto out = std::filesystem::temp_directory_path() / "fsi_test_checkpoint";
   std::filesystem::remove_all(out);

@@ -186,9 +186,9 @@ TEST_CASE("helmholtz: factored by default, direct with Crank-Nicolson, refused o
       read(replace(walls, "viscosity = 0.01", "viscosity = 0.01\nhelmholtz = \"direct\""), 0.5));
 }
 
-TEST_CASE("body_viscosity: kelvin-voigt by default, none, refused when unknown",
+TEST_CASE("body_viscosity: none by default, kelvin-voigt, refused when unknown",
           "[fluid][config]") {
-  CHECK_FALSE(read(kGood).bodies_inviscid);
+  CHECK(read(kGood).bodies_inviscid);
   CHECK(read(replace(kGood, "viscosity = 0.01", "viscosity = 0.01\nbody_viscosity = \"none\""))
             .bodies_inviscid);
   CHECK_FALSE(read(replace(kGood, "viscosity = 0.01",
