@@ -52,12 +52,16 @@ bool may_change(const std::string& path) {
 // Keys whose default changed, so that the effective scene records them from then on: a
 // checkpoint written before holds no such key, and ran as the value given here. A resumed run
 // that sets that value explicitly continues the same physics.
-bool legacy_value(const std::string& path, const Toml& now) {
+const std::map<std::string, std::string>& legacy_values() {
   static const std::map<std::string, std::string> kLegacy = {
       {"fluid.body_viscosity", "kelvin-voigt"},  // the default until the bodies became elastic
   };
-  const auto it = kLegacy.find(path);
-  return it != kLegacy.end() && now == Toml(it->second);
+  return kLegacy;
+}
+
+bool legacy_value(const std::string& path, const Toml& now) {
+  const auto it = legacy_values().find(path);
+  return it != legacy_values().end() && now.is_string() && now.as_string().str == it->second;
 }
 
 std::string first_difference(const Toml& a, const Toml& b, const std::string& path) {
@@ -211,11 +215,18 @@ H5File open_restart(const Runtime& rt) {
   const long step = *rt.restart_step();
   H5File h5(checkpoint_file(rt.out_dir(), step, rt.role()), H5File::Mode::read_only);
   const std::string key = changed_physics_key(h5.attribute_string("/", "scene"), rt.scene().effective_toml());
-  if (!key.empty())
+  if (!key.empty()) {
+    // A key recorded since its default changed: say what the checkpoint's run used.
+    std::string hint;
+    if (const auto it = legacy_values().find(key); it != legacy_values().end())
+      hint = fmt::format("; a checkpoint written before {} was recorded ran with {} = \"{}\": "
+                         "give that in the scene to resume it",
+                         key, key.substr(key.rfind('.') + 1), it->second);
     throw InputError(fmt::format(
         "{} differs from the run being resumed (checkpoint of step {} in {}): a restart may change "
-        "time.t_end and [output] only (in {})",
-        key, step, rt.out_dir().string(), rt.scene().file().string()));
+        "time.t_end and [output] only{} (in {})",
+        key, step, rt.out_dir().string(), hint, rt.scene().file().string()));
+  }
   return h5;
 }
 

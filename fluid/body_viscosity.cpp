@@ -33,9 +33,9 @@ namespace fluid {
 // so there the rows are read where they are stored instead of wrapped.
 //
 // Whether any rank has faces decides, the same on every rank (the halos below are collective);
-// a step whose footprint has faces after a step without any did not keep uⁿ and keeps the
-// viscosity inside the bodies that once (a body entering the grid; bodies there from the start
-// have faces at the first step).
+// with explicit diffusion a step whose footprint has faces after a step without any did not
+// keep uⁿ and keeps the viscosity inside the bodies that once (a body entering the grid; bodies
+// there from the start have faces at the first step; Crank-Nicolson always keeps uⁿ).
 void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
   if (!m_cfg.bodies_inviscid) return;
   const bool here = !in.solid_u_index.empty() || !in.solid_v_index.empty();

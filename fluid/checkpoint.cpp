@@ -46,6 +46,8 @@ void Solver::save(fsi::H5File* h5) const {
   if (!h5) return;
   h5->write("fluid/clock", std::vector<double>{m_t, m_dt_prev});
   h5->write("fluid/step", std::vector<std::int64_t>{m_step});
+  // whether the last step's footprint had faces (the next step keeps uⁿ for body_viscosity)
+  h5->write("fluid/body_faces", std::vector<std::int64_t>{m_body_faces ? 1 : 0});
 }
 
 void Solver::load(const fsi::H5File& h5) {
@@ -59,6 +61,8 @@ void Solver::load(const fsi::H5File& h5) {
   const auto clock = h5.read_doubles("fluid/clock");
   m_t = clock.at(0), m_dt_prev = clock.at(1);
   m_step = h5.read_int64s("fluid/step").at(0);
+  // (absent in a checkpoint written before it was kept: uⁿ is kept at the first step)
+  if (h5.exists("fluid/body_faces")) m_body_faces = h5.read_int64s("fluid/body_faces").at(0) != 0;
   m_bnd.load(h5, "fluid/boundaries");
   m_phase = Phase::between_steps;
 }

@@ -83,10 +83,10 @@ struct Config {
   // the default; factored_solver.hpp: second order, no transform) or exact by transforms
   // ("direct").
   bool factored_helmholtz = true;  // fluid.helmholtz
-  // fluid.body_viscosity = "none": the fluid's viscous stress weighted by 1 − φ (φ the bodies'
-  // volume fraction), so that bodies are purely elastic (body_viscosity.cpp); "kelvin-voigt"
-  // (the default): the fluid's viscosity everywhere, bodies are Kelvin-Voigt with μ_s = μ_f.
-  bool bodies_inviscid = false;
+  // fluid.body_viscosity = "none" (the default): the fluid's viscous stress weighted by 1 − φ
+  // (φ the bodies' volume fraction), so that bodies are purely elastic (body_viscosity.cpp);
+  // "kelvin-voigt": the fluid's viscosity everywhere, bodies are Kelvin-Voigt with μ_s = μ_f.
+  bool bodies_inviscid = true;
   // fluid.forcing_time tau >= 0: the immersed forcing's relaxation time (forcing.cpp). A face of
   // volume fraction alpha is blended by beta = alpha dt / ((1 - alpha) tau + alpha dt), so a
   // steady flow's slip in a cut face is (1 - alpha)/alpha tau R whatever dt; < 0 (not given):

@@ -228,8 +228,8 @@ class Solver {
   std::array<Field, 2> m_body_alpha;
   std::array<std::vector<char>, 2> m_body_mark;
   // body_viscosity = "none": whether the last step's footprint had faces on any rank (true
-  // before the first step, also of a restart), and whether this step kept uⁿ in m_un, m_vn
-  // (begin_step keeps it for the correction only while there are bodies).
+  // before the first step; a checkpoint keeps it), and whether this step kept uⁿ in m_un, m_vn
+  // (begin_step keeps it for the correction only while there are bodies; Crank-Nicolson always).
   bool m_body_faces = true;
   bool m_un_kept = false;
   std::array<std::vector<double>, 2> m_force_sum;  // end_substeps: the solid force's sums

@@ -65,6 +65,17 @@ def _children_cpu():
     return r.ru_utime + r.ru_stime
 
 
+def same_defaults(folder):
+    """Whether a finished run ran with today's defaults of the keys whose default changed: its
+    effective scene records them (fluid.body_viscosity since the bodies became elastic by
+    default; before, an unnamed key meant "kelvin-voigt")."""
+    path = os.path.join(folder, "scene.effective.toml")
+    if not os.path.exists(path):
+        return True
+    text = open(path).read()
+    return "[fluid]" not in text or "body_viscosity" in text
+
+
 def run(name, scene_text, work=None, programs=None, check=True, reuse=False):
     """Write WORK/name.toml (WORK: the case's OUT) and run it into WORK/name: Run(folder, wall,
     cpu, returncode, log). programs: the roles, else fsi-plan's. check: a failed job stops the
@@ -75,7 +86,8 @@ def run(name, scene_text, work=None, programs=None, check=True, reuse=False):
     folder = os.path.join(work, name)
     done = os.path.join(folder, "summary.json")
     measured = os.path.join(folder, "job_time.json")  # this module's wall and CPU of the job
-    if reuse and os.path.exists(done) and os.path.exists(scene) and open(scene).read() == scene_text:
+    if reuse and os.path.exists(done) and os.path.exists(scene) and open(scene).read() == scene_text \
+            and same_defaults(folder):
         with open(done) as f:
             wall = json.load(f).get("wall_time", {})
         wall = max(wall.values()) if isinstance(wall, dict) and wall else float(wall or 0.0)

@@ -17,8 +17,9 @@ set by TAU instead of dt; fluid/forcing.cpp); runs and the --bands-xy JSON named
 `--helmholtz direct|factored`: fluid.helmholtz in the scenes (factored by default: the key is
 always written, so that --reuse never takes a run of the direct solve for one of the factored);
 runs with the direct solve are named *-direct.
-`--body-viscosity none`: fluid.body_viscosity = "none" in the scenes (the mixture stress on the
-cut faces, fluid/README.md), every output under OUT/body-viscosity-none.
+`--body-viscosity none|kelvin-voigt`: fluid.body_viscosity written into the scenes (none, the
+fluid's default: the mixture stress on the cut faces, fluid/README.md; kelvin-voigt: the model
+of the README's tables), every output under OUT/body-viscosity-X.
 Environment (set by `./fsi validate`): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN."""
 import glob
 import json
@@ -57,7 +58,8 @@ _p.add_argument("--cases", nargs="+", choices=["cfd1", "cfd2"], default=["cfd1",
 _p.add_argument("--helmholtz", choices=["direct", "factored"], default="factored",
                 help="fluid.helmholtz of the scenes (Crank-Nicolson's Helmholtz solves)")
 _p.add_argument("--body-viscosity", choices=["kelvin-voigt", "none"], default=None,
-                help="fluid.body_viscosity of the scenes (default: not given, kelvin-voigt)")
+                help="fluid.body_viscosity of the scenes (default: not given, the fluid's none; "
+                     "the README's tables before it are kelvin-voigt)")
 ARGS = _p.parse_args()
 if ARGS.forcing_time is not None and not ARGS.bands_xy:
     _p.error("--forcing-time goes with --bands-xy (the other modes' files are not named by it)")

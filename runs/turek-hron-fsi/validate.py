@@ -63,7 +63,8 @@ _p.add_argument("--smoothing", action="store_true",
                 help="FSI2 on L2 with the footprint smoothed (coupler.footprint_smoothing 0, 0.5, 1)")
 _p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
 _p.add_argument("--body-viscosity", choices=("kelvin-voigt", "none"), default=None,
-                help="[fluid] body_viscosity of every run (default: the scenes', kelvin-voigt)")
+                help="[fluid] body_viscosity of every run (default: not written, the fluid's "
+                     "default none; the README's tables before it are kelvin-voigt)")
 ARGS = _p.parse_args()
 # --ci: L2 only, the frequency judged against the refined values and reported against the 2006
 # table's 2.0 Hz, which this method misses by 3.4-3.5 % on every level (README, "Frequency").

@@ -114,6 +114,6 @@ finish("two-layer-channel", metrics,
        {"runs": results, "settings": {"V0": tl.V0, "omega": tl.OMEGA, "rho_f": tl.RHO_F,
                                       "mu": tl.MU, "G": tl.G, "K": tl.K_BULK, "rho_s": tl.RHO_S,
                                       "dt": [dt_for(n) for n in GRIDS], "t_end": T_END,
-                                      "body_viscosity": MODEL or "kelvin-voigt",
+                                      "body_viscosity": MODEL,
                                       "reference_mu_s": MU_S}},
        short=ARGS.short, name=f"summary{SUFFIX}.json")

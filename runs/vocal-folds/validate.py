@@ -39,6 +39,9 @@ solid.predictor = "acceleration"); --newmark-gamma G OUT/gamma-G (the solid's Ne
 gamma = G and beta = (G + 1/2)^2 / 4 instead of the scene's 0.55; solid.newmark_gamma,
 solid/README.md, "Newmark's parameters"; 0.5 is the paper's trapezoidal rule). So the default
 runs are in OUT/neo-hookean/planes/substeps-4/upwind3.
+--body-viscosity kelvin-voigt: the folds carry the fluid's viscous stress ([fluid]
+  body_viscosity; the runs of README.md before the fluid's default became "none" did), outputs
+  under OUT/.../body-viscosity-kelvin-voigt.
 --checkpoint-interval T: the coupled runs write a checkpoint every T (`./fsi run SCENE --restart
   RUN` resumes one; the outputs are unchanged).
 With no option (`./fsi validate vocal-folds`): --modes, --short and --sweep."""
@@ -104,6 +107,9 @@ P.add_argument("--predictor", action="store_true",
 P.add_argument("--newmark-gamma", type=float, metavar="G", default=None,
                help="the solid's Newmark gamma instead of the scene's 0.55 (solid.newmark_gamma; "
                     "beta = (G + 1/2)^2 / 4; 0.5: the paper's trapezoidal rule)")
+P.add_argument("--body-viscosity", choices=("none", "kelvin-voigt"), default=None,
+               help="[fluid] body_viscosity (default: the fluid's, none; kelvin-voigt: the folds "
+                    "carry the fluid's viscous stress, as every run before the default changed)")
 P.add_argument("--checkpoint-interval", type=cli.positive, metavar="T", default=None,
                help="the coupled runs write a checkpoint every T")
 ARGS = P.parse_args()
@@ -118,7 +124,7 @@ OUT = TOP = job.out_dir("vocal-folds")
 # and `./fsi report` look for a case's summary.
 DEFAULT_SETUP = all(getattr(ARGS, k) == P.get_default(k) for k in (
     "material", "dt", "wall_planes", "substeps", "cover_size", "convection", "predictor",
-    "newmark_gamma"))
+    "newmark_gamma", "body_viscosity"))
 for sub in (None if ARGS.material == "saint-venant-kirchhoff" else ARGS.material,
             None if ARGS.dt is None else f"dt-{ARGS.dt:g}",
             "planes" if ARGS.wall_planes else None,
@@ -126,7 +132,8 @@ for sub in (None if ARGS.material == "saint-venant-kirchhoff" else ARGS.material
             None if ARGS.cover_size is None else f"cover-{ARGS.cover_size:g}",
             "upwind3" if UPWIND3 else None,
             "predictor" if ARGS.predictor else None,
-            None if ARGS.newmark_gamma is None else f"gamma-{ARGS.newmark_gamma:g}"):
+            None if ARGS.newmark_gamma is None else f"gamma-{ARGS.newmark_gamma:g}",
+            None if ARGS.body_viscosity is None else f"body-viscosity-{ARGS.body_viscosity}"):
     if sub:
         OUT = job.OUT = os.path.join(OUT, sub)
         os.makedirs(OUT, exist_ok=True)
@@ -205,6 +212,9 @@ bodies = ["upper"]
         text = text.replace("newton_max_iterations = 30", 'newton_max_iterations = 30\npredictor = "acceleration"')
     if ARGS.newmark_gamma is not None:
         text = text.replace("newmark_gamma = 0.55", f"newmark_gamma = {ARGS.newmark_gamma!r}")
+    if ARGS.body_viscosity is not None and fluid:
+        text = text.replace("viscosity = 6.666666666666667e-4",
+                            f'viscosity = 6.666666666666667e-4\nbody_viscosity = "{ARGS.body_viscosity}"')
     return text
 
 
@@ -390,6 +400,8 @@ def run_state(name, text):
     "incomplete" (data without a summary or a log: the job was killed), "missing"."""
     scene_file, folder = os.path.join(OUT, name + ".toml"), os.path.join(OUT, name)
     if not (os.path.isdir(folder) and os.path.exists(scene_file) and open(scene_file).read() == text):
+        return "missing"
+    if not job.same_defaults(folder):  # the same text ran under an earlier default (job.py)
         return "missing"
     if locked(folder):
         return "running"

@@ -52,6 +52,7 @@ TEST_CASE("a key recorded since its default changed: absent counts as its old va
     return replaced(kScene, "viscosity = 0.01", std::string("viscosity = 0.01\nbody_viscosity = ") + v);
   };
   CHECK(changed_physics_key(kScene, with("\"kelvin-voigt\"")).empty());
+  CHECK(changed_physics_key(kScene, with("'kelvin-voigt'")).empty());
   CHECK(changed_physics_key(kScene, with("\"none\"")) == "fluid.body_viscosity");
   CHECK(changed_physics_key(with("\"none\""), with("\"kelvin-voigt\"")) == "fluid.body_viscosity");
   CHECK(changed_physics_key(with("\"kelvin-voigt\""), kScene) == "fluid.body_viscosity");
