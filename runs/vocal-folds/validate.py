@@ -574,12 +574,20 @@ def axis_angle(d):
 
 
 def output_gaps(folder, hist):
-    """[(key, time)] of solid.h5's output steps, the smallest contact gap and whether the folds
-    touch each other there (CLOSED; solid_history.csv's row nearest in time)."""
+    """[(key, time)] of solid.h5's output steps, the gap between the folds there (the smallest
+    distance between a node of one and a node of the other: solid_history.csv's min_gap counts
+    the wall planes and self-contact too, 0 at every step with the planes) and whether the folds
+    touch each other (CLOSED; solid_history.csv's row nearest in time)."""
     with h5py.File(os.path.join(folder, "solid.h5"), "r") as s:
         steps = [(k, float(s[k].attrs["time"])) for k in outputs.step_keys(s)]
+        gaps = []
+        for k, _ in steps:
+            lo, up = np.array(s[k]["body_lower/position"]), np.array(s[k]["body_upper/position"])
+            lo = lo[lo[:, 1] > lo[:, 1].max() - 0.1]  # the nodes near each fold's tip
+            up = up[up[:, 1] < up[:, 1].min() + 0.1]
+            gaps.append(float(np.sqrt(((lo[:, None, :] - up[None, :, :]) ** 2).sum(-1)).min()))
     rows = [int(np.argmin(np.abs(hist["time"] - tm))) for _, tm in steps]
-    return steps, hist["min_gap"][rows], folds_touch(hist)[rows]
+    return steps, np.array(gaps), folds_touch(hist)[rows]
 
 
 def draw_field(a, folder, step, time_s, title):
@@ -732,19 +740,21 @@ def sweep_plots(rows, modes_f, x_ref, shapes):
         folder = os.path.join(OUT, r["name"])
         try:
             steps, gaps, touch = output_gaps(folder, hist)
-            # Closed: the smallest gap among the steps in contact, else after t = 1 (before, the
-            # gap is the initial one); open: the largest gap after t = 1. Without output after
-            # t = 1, the whole run but its initial state.
+            # Closed: the smallest gap among the steps in contact after t = 1 (before, the folds
+            # still touch as they started at h = 0), else among any in contact, else after t = 1;
+            # open: the largest gap after t = 1. Without output after t = 1, the whole run but
+            # its initial state.
             late = [n for n, (_, tm) in enumerate(steps) if tm >= SETTLE] or list(range(1, len(steps)))
-            closed = list(np.nonzero(touch)[0]) or late
+            touching = list(np.nonzero(touch)[0])
+            closed = [n for n in touching if n in set(late)] or touching or late
             pick = {"closed": closed[int(np.argmin(gaps[closed]))], "open": late[int(np.argmax(gaps[late]))]}
             for j, kind in enumerate(("closed", "open")):
                 key, tm = steps[pick[kind]]
                 where = (", contact" if touch[pick[kind]] else "") + \
                     ("" if steps[late[0]][1] >= SETTLE else f", no output after t = {SETTLE}")
                 draw_field(ax[i, j], folder, key, tm, f"{label[id(r)]}, {kind}: t = {tm:.2f}, "
-                           f"min gap {gaps[pick[kind]]:.4f}{where}")
-                r["fields"][kind] = {"time": tm, "min_gap": float(gaps[pick[kind]]),
+                           f"gap {gaps[pick[kind]]:.4f}{where}")
+                r["fields"][kind] = {"time": tm, "gap": float(gaps[pick[kind]]),
                                      "contact": bool(touch[pick[kind]])}
         except (OSError, RuntimeError, KeyError, TypeError, ValueError) as e:  # no or unreadable output yet
             ax[i, 0].text(0.5, 0.5, f"{label[id(r)]}: no fields ({e})", ha="center",
