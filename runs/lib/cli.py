@@ -12,6 +12,15 @@ def parser(doc, short=True):
     return p
 
 
+def body_viscosity(p, what):
+    """The --body-viscosity option of a case whose runs WHAT ([fluid] body_viscosity written
+    into its scenes; not given: the fluid's default, "none")."""
+    p.add_argument("--body-viscosity", choices=("none", "kelvin-voigt"), default=None,
+                   help=f"[fluid] body_viscosity of {what} (default: not written, the fluid's "
+                        "none; the README's tables measured before it became the default are "
+                        "kelvin-voigt), outputs under OUT/.../body-viscosity-X")
+
+
 def ints(text):
     """A comma-separated list of integers, for `type=`."""
     try:

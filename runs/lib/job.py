@@ -33,6 +33,17 @@ def out_dir(case):
     return OUT
 
 
+def nest(*parts):
+    """OUT/part/part/... for the parts that are not None or empty (a variant's outputs in a
+    folder of their own), created; also job.OUT."""
+    global OUT
+    for part in parts:
+        if part:
+            OUT = os.path.join(OUT, part)
+            os.makedirs(OUT, exist_ok=True)
+    return OUT
+
+
 def roles(scene):
     """The programs a scene file needs, as build/bin/fsi-plan says (its `programs:` line: the
     program of each role, e.g. solid-rigid for the solid role)."""

@@ -57,18 +57,14 @@ _p.add_argument("--cases", nargs="+", choices=["cfd1", "cfd2"], default=["cfd1",
                 help="--bands-xy: these cases only")
 _p.add_argument("--helmholtz", choices=["direct", "factored"], default="factored",
                 help="fluid.helmholtz of the scenes (Crank-Nicolson's Helmholtz solves)")
-_p.add_argument("--body-viscosity", choices=["kelvin-voigt", "none"], default=None,
-                help="fluid.body_viscosity of the scenes (default: not given, the fluid's none; "
-                     "the README's tables before it are kelvin-voigt)")
+cli.body_viscosity(_p, "the scenes")
 ARGS = _p.parse_args()
 if ARGS.forcing_time is not None and not ARGS.bands_xy:
     _p.error("--forcing-time goes with --bands-xy (the other modes' files are not named by it)")
 SHORT, REUSE = ARGS.short, ARGS.reuse
 HERE = os.path.dirname(os.path.abspath(__file__))
-OUT = job.out_dir("turek-hron-cfd")
-if ARGS.body_viscosity is not None:
-    OUT = job.OUT = os.path.join(OUT, f"body-viscosity-{ARGS.body_viscosity}")
-    os.makedirs(OUT, exist_ok=True)
+job.out_dir("turek-hron-cfd")
+OUT = job.nest(ARGS.body_viscosity and f"body-viscosity-{ARGS.body_viscosity}")
 
 H, L = 0.41, 2.5
 TAU_TAG = "" if ARGS.forcing_time is None else f"-tau{ARGS.forcing_time:g}"

@@ -62,9 +62,7 @@ _p.add_argument("--fsi1-bands-xy", action="store_true", help="FSI1 with bands in
 _p.add_argument("--smoothing", action="store_true",
                 help="FSI2 on L2 with the footprint smoothed (coupler.footprint_smoothing 0, 0.5, 1)")
 _p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
-_p.add_argument("--body-viscosity", choices=("kelvin-voigt", "none"), default=None,
-                help="[fluid] body_viscosity of every run (default: not written, the fluid's "
-                     "default none; the README's tables before it are kelvin-voigt)")
+cli.body_viscosity(_p, "every run")
 ARGS = _p.parse_args()
 # --ci: L2 only, the frequency judged against the refined values and reported against the 2006
 # table's 2.0 Hz, which this method misses by 3.4-3.5 % on every level (README, "Frequency").
@@ -73,10 +71,8 @@ SHORT = ARGS.short or CI
 REUSE = ARGS.reuse
 COARSE = ARGS.coarse
 HERE = os.path.dirname(os.path.abspath(__file__))
-OUT = job.out_dir("turek-hron-fsi")
-if ARGS.body_viscosity is not None:
-    OUT = job.OUT = os.path.join(OUT, f"body-viscosity-{ARGS.body_viscosity}")
-    os.makedirs(OUT, exist_ok=True)
+job.out_dir("turek-hron-fsi")
+OUT = job.nest(ARGS.body_viscosity and f"body-viscosity-{ARGS.body_viscosity}")
 H, L = 0.41, 2.5
 
 # Turek & Hron (2006), Table "FSI2" and "FSI1" (reference.csv, with the source).

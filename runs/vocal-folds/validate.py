@@ -107,9 +107,7 @@ P.add_argument("--predictor", action="store_true",
 P.add_argument("--newmark-gamma", type=float, metavar="G", default=None,
                help="the solid's Newmark gamma instead of the scene's 0.55 (solid.newmark_gamma; "
                     "beta = (G + 1/2)^2 / 4; 0.5: the paper's trapezoidal rule)")
-P.add_argument("--body-viscosity", choices=("none", "kelvin-voigt"), default=None,
-               help="[fluid] body_viscosity (default: the fluid's, none; kelvin-voigt: the folds "
-                    "carry the fluid's viscous stress, as every run before the default changed)")
+cli.body_viscosity(P, "the coupled runs")
 P.add_argument("--checkpoint-interval", type=cli.positive, metavar="T", default=None,
                help="the coupled runs write a checkpoint every T")
 ARGS = P.parse_args()
@@ -125,18 +123,15 @@ OUT = TOP = job.out_dir("vocal-folds")
 DEFAULT_SETUP = all(getattr(ARGS, k) == P.get_default(k) for k in (
     "material", "dt", "wall_planes", "substeps", "cover_size", "convection", "predictor",
     "newmark_gamma", "body_viscosity"))
-for sub in (None if ARGS.material == "saint-venant-kirchhoff" else ARGS.material,
-            None if ARGS.dt is None else f"dt-{ARGS.dt:g}",
-            "planes" if ARGS.wall_planes else None,
-            f"substeps-{ARGS.substeps}" if ARGS.substeps else None,
-            None if ARGS.cover_size is None else f"cover-{ARGS.cover_size:g}",
-            "upwind3" if UPWIND3 else None,
-            "predictor" if ARGS.predictor else None,
-            None if ARGS.newmark_gamma is None else f"gamma-{ARGS.newmark_gamma:g}",
-            None if ARGS.body_viscosity is None else f"body-viscosity-{ARGS.body_viscosity}"):
-    if sub:
-        OUT = job.OUT = os.path.join(OUT, sub)
-        os.makedirs(OUT, exist_ok=True)
+OUT = job.nest(None if ARGS.material == "saint-venant-kirchhoff" else ARGS.material,
+               None if ARGS.dt is None else f"dt-{ARGS.dt:g}",
+               "planes" if ARGS.wall_planes else None,
+               f"substeps-{ARGS.substeps}" if ARGS.substeps else None,
+               None if ARGS.cover_size is None else f"cover-{ARGS.cover_size:g}",
+               "upwind3" if UPWIND3 else None,
+               "predictor" if ARGS.predictor else None,
+               None if ARGS.newmark_gamma is None else f"gamma-{ARGS.newmark_gamma:g}",
+               None if ARGS.body_viscosity is None else f"body-viscosity-{ARGS.body_viscosity}")
 # The substeps' CFL number: AB2 with third-order upwind fluxes is stable to about 0.58 (1D).
 SUBSTEPS_CFL = 0.5 if UPWIND3 else 0.8
 HERE = os.path.dirname(os.path.abspath(__file__))
