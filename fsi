@@ -513,6 +513,11 @@ print("      trapezoidal rule kept) | fewer Newton iterations and cut steps | to
 print("      -> 1 091 s (5.07 -> 4.55 ms per step; solid 1.89 -> 1.56, footprint 1.35 -> 1.24, fluid")
 print("      1.65 -> 1.59 ms; Newton 3.46 -> 3.11 per step, 4 -> 1 steps cut; CPU 2 404 -> 2 091 s);")
 print("      a new trajectory (67 closures, 5.74)")
+print("  body_viscosity = \"none\" (the default since): its correction with each flux once on the")
+print("      footprint's boxes, each alpha read once (was: per face, its fluxes and the alpha they read")
+print("      again, 11 to 13 reads a face) | most of the correction's 0.5 ms per step | h = 0,")
+print("      upwind3, 5000 steps from rest, one run before, two after: the fluid's predictor phase")
+print("      1.29 -> 1.02, 1.06 ms per step (Kelvin-Voigt folds 0.78); the same bits")
 PY
 }
 

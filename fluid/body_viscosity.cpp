@@ -42,6 +42,9 @@ void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
   m_body_faces = m_dec.serial() ? here : m_dec.sum(here ? 1.0 : 0.0) > 0;
   if (!m_body_faces || !m_un_kept) return;
   const int nx = m_grid.nx(), ny = m_grid.ny();
+  if (m_body_alpha[0].a.empty())
+    m_body_alpha = {Field(nx + 1, ny, m_dec.lo(), m_dec.hi()),
+                    Field(nx, ny + 1, m_dec.lo(), m_dec.v_hi())};
   const bool px = m_grid.x().periodic(), py = m_grid.y().periodic();
   const Axis& X = m_grid.x();
   const Axis& Y = m_grid.y();
@@ -63,56 +66,84 @@ void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
     if (!py && (j < j_lo[c] || j >= j_hi[c])) return 1.0;
     return m_body_alpha[c](i, j);
   };
+  // The α per face, and per family the box f of the footprint's faces the step solves for.
+  Box f[2] = {Box::none(), Box::none()};
   for (int c = 0; c < 2; ++c)
     for (std::size_t q = 0; q < idx[c].size(); ++q) {
       const auto [i, j] = face_of(c, idx[c][q]);
       double& a = m_body_alpha[c](i, owned(j, c));
       a = std::min(1.0, a + alpha[c][q]);
+      if (i >= i_lo[c] && i < i_hi[c] && j >= j_lo[c] && j < j_hi[c]) f[c].join({i, i, j, j});
     }
   m_dec.halo(m_body_alpha[0]);
   m_dec.halo(m_body_alpha[1]);
-  const Field& U = m_un;
-  const Field& V = m_vn;
-  // φ at the corner (x face i, y face j): u faces (i, j − 1), (i, j); v faces (i − 1, j), (i, j).
-  auto corner = [&](int i, int j) {
-    return std::min(std::min(a_at(0, i, j - 1), a_at(0, i, j)),
-                    std::min(a_at(1, i - 1, j), a_at(1, i, j)));
-  };
-  // ∂y u + ∂x v at that corner.
-  auto shear = [&](int i, int j) {
-    return (U(i, j) - U(i, j - 1)) * ydi[j] + (V(i, j) - V(i - 1, j)) * xdi[i];
-  };
-  for (int c = 0; c < 2; ++c) {
-    Field& F = c == 0 ? m_u : m_v;
-    std::vector<char>& mark = m_body_mark[c];
-    for (std::size_t q = 0; q < idx[c].size(); ++q) {
-      const auto [i, j] = face_of(c, idx[c][q]);
-      if (i < i_lo[c] || i >= i_hi[c] || j < j_lo[c] || j >= j_hi[c]) continue;
-      char& m = mark[std::size_t(i) + std::size_t(ni[c]) * j];
-      if (m) continue;
-      m = 1;
-      const double a = a_at(c, i, j);
-      double d;
-      if (c == 0) {
-        const double c0 = U(i, j);
-        d = 2 * (std::min(a, a_at(0, i + 1, j)) * (U(i + 1, j) - c0) * xwi[i] -
-                 std::min(a, a_at(0, i - 1, j)) * (c0 - U(i - 1, j)) * xwi[i - 1]) * xdi[i] +
-            (corner(i, j + 1) * shear(i, j + 1) - corner(i, j) * shear(i, j)) * yci[j];
-      } else {
-        const double c0 = V(i, j);
-        d = (corner(i + 1, j) * shear(i + 1, j) - corner(i, j) * shear(i, j)) * xci[i] +
-            2 * (std::min(a, a_at(1, i, j + 1)) * (V(i, j + 1) - c0) * ywi[j] -
-                 std::min(a, a_at(1, i, j - 1)) * (c0 - V(i, j - 1)) * ywi[j - 1]) * ydi[j];
-      }
-      F(i, j) -= dt * m_nu * d;
+  // Each flux once, on boxes: the corners the faces of f border, the centres between them and
+  // their neighbours, and the α those fluxes read (each a_at once). A flux reading a face outside
+  // the footprint has φ = 0, and each is the one the difference at a face would compute, so a
+  // face gets the same bits as with its fluxes computed for it alone.
+  if (!f[0].empty() || !f[1].empty()) {
+    // Corners: (i, j), (i, j + 1) of a u face; (i, j), (i + 1, j) of a v face.
+    Box k = Box::none();
+    if (!f[0].empty()) k.join({f[0].i0, f[0].i1, f[0].j0, f[0].j1 + 1});
+    if (!f[1].empty()) k.join({f[1].i0, f[1].i1 + 1, f[1].j0, f[1].j1});
+    // α read: a u face's centre neighbours (i ± 1) and a corner's u faces (j − 1, j); a v face's
+    // (j ± 1) and a corner's v faces (i − 1, i).
+    Box b[2] = {Box::none(), Box::none()};
+    if (!f[0].empty()) b[0].join({f[0].i0 - 1, f[0].i1 + 1, f[0].j0, f[0].j1});
+    b[0].join({k.i0, k.i1, k.j0 - 1, k.j1});
+    if (!f[1].empty()) b[1].join({f[1].i0, f[1].i1, f[1].j0 - 1, f[1].j1 + 1});
+    b[1].join({k.i0 - 1, k.i1, k.j0, k.j1});
+    for (int c = 0; c < 2; ++c) {
+      m_bv_phi[c].resize(b[c]);
+      for (int j = b[c].j0; j <= b[c].j1; ++j)
+        for (int i = b[c].i0; i <= b[c].i1; ++i) m_bv_phi[c](i, j) = a_at(c, i, j);
     }
+    const Patch& A = m_bv_phi[0];
+    const Patch& B = m_bv_phi[1];
+    const Field& U = m_un;
+    const Field& V = m_vn;
+    // φ (∂y u + ∂x v) at the corners, φ the smallest α of u faces (i, j − 1), (i, j) and v faces
+    // (i − 1, j), (i, j).
+    Patch& K = m_bv_corner;
+    K.resize(k);
+    for (int j = k.j0; j <= k.j1; ++j)
+      for (int i = k.i0; i <= k.i1; ++i) {
+        const double phi = std::min(std::min(A(i, j - 1), A(i, j)), std::min(B(i - 1, j), B(i, j)));
+        K(i, j) = phi * ((U(i, j) - U(i, j - 1)) * ydi[j] + (V(i, j) - V(i - 1, j)) * xdi[i]);
+      }
+    // φ ∂x u between u faces i and i + 1; φ ∂y v between v faces j and j + 1.
+    Patch& Cu = m_bv_centre[0];
+    Patch& Cv = m_bv_centre[1];
+    if (!f[0].empty()) {
+      Cu.resize({f[0].i0 - 1, f[0].i1, f[0].j0, f[0].j1});
+      for (int j = f[0].j0; j <= f[0].j1; ++j)
+        for (int i = f[0].i0 - 1; i <= f[0].i1; ++i)
+          Cu(i, j) = std::min(A(i, j), A(i + 1, j)) * (U(i + 1, j) - U(i, j)) * xwi[i];
+    }
+    if (!f[1].empty()) {
+      Cv.resize({f[1].i0, f[1].i1, f[1].j0 - 1, f[1].j1});
+      for (int j = f[1].j0 - 1; j <= f[1].j1; ++j)
+        for (int i = f[1].i0; i <= f[1].i1; ++i)
+          Cv(i, j) = std::min(B(i, j), B(i, j + 1)) * (V(i, j + 1) - V(i, j)) * ywi[j];
+    }
+    // Each face of the footprint once (α > 0 in its box: a face listed twice is taken once).
+    const double s = dt * m_nu;
+    for (int j = f[0].j0; j <= f[0].j1; ++j)
+      for (int i = f[0].i0; i <= f[0].i1; ++i)
+        if (m_body_alpha[0](i, j) > 0)
+          m_u(i, j) -= s * (2 * (Cu(i, j) - Cu(i - 1, j)) * xdi[i] +
+                            (K(i, j + 1) - K(i, j)) * yci[j]);
+    for (int j = f[1].j0; j <= f[1].j1; ++j)
+      for (int i = f[1].i0; i <= f[1].i1; ++i)
+        if (m_body_alpha[1](i, j) > 0)
+          m_v(i, j) -= s * ((K(i + 1, j) - K(i, j)) * xci[i] +
+                            2 * (Cv(i, j) - Cv(i, j - 1)) * ydi[j]);
   }
   // Back to zero for the next step (the footprint moves).
   for (int c = 0; c < 2; ++c)
     for (std::size_t q = 0; q < idx[c].size(); ++q) {
       const auto [i, j] = face_of(c, idx[c][q]);
       m_body_alpha[c](i, j) = 0;
-      m_body_mark[c][std::size_t(i) + std::size_t(ni[c]) * j] = 0;
     }
 }
 

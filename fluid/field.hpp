@@ -3,7 +3,9 @@
 // v nx x (ny+1), p nx x ny.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "error.hpp"
@@ -36,6 +38,40 @@ struct Field {
   // Pointer to element (0, j); valid offsets -1 .. ni.
   double* row(int j) { return a.data() + 1 + std::size_t(sx) * (j - jlo + 1); }
   const double* row(int j) const { return a.data() + 1 + std::size_t(sx) * (j - jlo + 1); }
+};
+
+// An index box [i0, i1] x [j0, j1], both ends included; none() is empty and joins anything.
+struct Box {
+  int i0 = 0, i1 = -1, j0 = 0, j1 = -1;
+  static Box none() {
+    constexpr int lo = std::numeric_limits<int>::min(), hi = std::numeric_limits<int>::max();
+    return {hi, lo, hi, lo};
+  }
+  bool empty() const { return i0 > i1 || j0 > j1; }
+  void join(const Box& o) {
+    i0 = std::min(i0, o.i0), i1 = std::max(i1, o.i1);
+    j0 = std::min(j0, o.j0), j1 = std::max(j1, o.j1);
+  }
+};
+
+// Values on a box of grid indices (i fastest), a scratch array that keeps its capacity.
+struct Patch {
+  Box box;
+  int w = 0;
+  std::vector<double> v;
+  void resize(const Box& b) {
+    box = b;
+    w = b.i1 - b.i0 + 1;
+    v.resize(std::size_t(w) * std::size_t(b.j1 - b.j0 + 1));
+  }
+  double& operator()(int i, int j) {
+    FSI_ASSERT(i >= box.i0 && i <= box.i1 && j >= box.j0 && j <= box.j1);
+    return v[std::size_t(i - box.i0) + std::size_t(w) * std::size_t(j - box.j0)];
+  }
+  double operator()(int i, int j) const {
+    FSI_ASSERT(i >= box.i0 && i <= box.i1 && j >= box.j0 && j <= box.j1);
+    return v[std::size_t(i - box.i0) + std::size_t(w) * std::size_t(j - box.j0)];
+  }
 };
 
 // The second row beyond each edge of a slab (rows lo - 2 and hi + 1, ghost columns included),

@@ -155,19 +155,14 @@ Solver::Solver(const Config& c, double dt, MPI_Comm comm)
     m_slab_poisson = std::make_unique<SlabSolver>(pt, ps, 0.0, m_t_axis, ny, 0, comm);
     m_slab_poisson->set_mean_weights(w);
   }
-  if (c.implicit || c.bodies_inviscid) {
+  // u^n: body_viscosity = "none" has begin_step copy it once the footprint has faces, and the
+  // α fields are made at the first faces (body_viscosity.cpp), so a run without bodies has none.
+  if (c.implicit) {
     m_un = Field(nx + 1, ny, lo, hi);
     m_vn = Field(nx, ny + 1, lo, vhi);
-  }
-  if (c.implicit) {
     m_lu = Field(nx + 1, ny, lo, hi);
     m_lv = Field(nx, ny + 1, lo, vhi);
     build_implicit(dt);
-  }
-  if (c.bodies_inviscid) {
-    m_body_alpha = {Field(nx + 1, ny, lo, hi), Field(nx, ny + 1, lo, vhi)};
-    m_body_mark = {std::vector<char>(std::size_t(nx + 1) * ny, 0),
-                   std::vector<char>(std::size_t(nx) * (ny + 1), 0)};
   }
   m_bnd.fill_ghosts(m_u, m_v);
   for (int s : {int(left), int(right)})

@@ -223,10 +223,12 @@ class Solver {
   // (solve_implicit).
   Field m_un, m_vn;
   std::array<std::vector<double>, 2> m_pull;
-  // body_viscosity = "none": the volume fraction of the step's footprint per u, v face and a
-  // mark per face (body_viscosity.cpp), zero between steps.
+  // body_viscosity = "none": the volume fraction of the step's footprint per u, v face, zero
+  // between steps; the step's α, centre fluxes (u, v) and corner fluxes on their boxes
+  // (body_viscosity.cpp).
   std::array<Field, 2> m_body_alpha;
-  std::array<std::vector<char>, 2> m_body_mark;
+  std::array<Patch, 2> m_bv_phi, m_bv_centre;
+  Patch m_bv_corner;
   // body_viscosity = "none": whether the last step's footprint had faces on any rank (true
   // before the first step; a checkpoint keeps it), and whether this step kept uⁿ in m_un, m_vn
   // (begin_step keeps it for the correction only while there are bodies; Crank-Nicolson always).
