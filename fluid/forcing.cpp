@@ -10,9 +10,19 @@ constexpr double kCovered = 1 - 1e-9;
 
 // Immersed solid (paper Eq. 21): f_s = rho_f alpha (u_s - u~) / dt, then u~ += dt f_s / rho_f,
 // i.e. u~ <- (1 - alpha) u~ + alpha u_s, on the solid's faces (the u faces the step solves for:
-// the interior and a pressure side's boundary faces). Crank-Nicolson in increment form
-// (predictor.cpp) forced its explicit prediction before the solve (m_pull); here it sets the
-// covered faces to u_s, and f_s is the sum of both.
+// the interior and a pressure side's boundary faces).
+//
+// Crank-Nicolson in increment form (implicit_forcing = "increment", predictor.cpp) forced its
+// explicit prediction before the solve, pull = alpha (u_s - u^), and f_s = rho_f pull / dt: the
+// momentum the forcing put into the solve. The faces keep the solve's values, the covered ones
+// too. Its step, with A = I - (nu dt/2) L, D = diag(1 - alpha) and the body at rest,
+//   u^(n+1) = u^n + A^-1 (D (I + nu dt L) u^n - u^n),
+// has the explicit balance u = D (I + nu dt L) u as its steady state (u = u_s on a covered face),
+// and is stable at any lambda = nu dt / h^2 in a model of a wall (runs/sub-cell-wall/README.md).
+// Setting the covered faces to u_s after the solve, as an earlier form did, made it unstable from
+// lambda ~ 5: the solve treats the covered faces as fluid, so it gives the free faces next to
+// the body a larger increment than a solve with those faces held would, and the mode there grew
+// by a factor below -1 per step. A coupled iteration's redo solves again with its alpha and u_s.
 //
 // The relaxation time tau (fluid.forcing_time). The predictor carries the pressure gradient of
 // step n, u~ = u^n + dt R (R: convection, diffusion, -grad p^n, body force), so in a steady flow
@@ -43,14 +53,10 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
     return a >= kCovered ? 1.0 : a * dt / ((1 - a) * tau + a * dt);
   };
   auto force = [&](double& w, double a, double ws, double pull) {
-    if (!cn) {
-      const double f = rho * blend(a) * (ws - w) / dt;
-      w += dt * f / rho;
-      return f;
-    }
-    const double post = a >= kCovered ? ws - w : 0.0;
-    w += post;
-    return rho * (pull + post) / dt;
+    if (cn) return rho * pull / dt;
+    const double f = rho * blend(a) * (ws - w) / dt;
+    w += dt * f / rho;
+    return f;
   };
   for (std::size_t q = 0; q < in.solid_u_index.size(); ++q) {
     const auto [i, j] = face_of(0, in.solid_u_index[q]);

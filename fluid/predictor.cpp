@@ -169,9 +169,8 @@ void Solver::predictor_implicit(double dt, double t_half) {
 
 // The Crank-Nicolson solve of the step (predictor_implicit): the forcing alpha (u_s - u^) on u^
 // (kept in m_pull for the reaction), (I - theta L0) Y = u^_f - u^n + boundary increment,
-// u~ = u^n + Y. A coupled iteration's redo keeps u~ (solved with the first iteration's alpha and
-// u_s, the coupler's estimate of v^(n+1)) and sets the covered faces again: their reaction's
-// response to the iterated velocity is rho_f / dt, the one the solid linearises.
+// u~ = u^n + Y. A coupled iteration's redo takes u^ again and solves with its alpha and u_s
+// (forcing.cpp: why the faces keep the solve's values).
 void Solver::solve_implicit(const CouplingIn& in) {
   const int nx = m_grid.nx(), ny = m_grid.ny();
   const double scale = -1.0 / (0.5 * m_nu * m_begun_dt);  // the Helmholtz solver's B / -theta

@@ -339,8 +339,11 @@ void Solver::end_step(double dt, const CouplingIn& in, CouplingOut& out) {
     const PhaseTimer t(m_time.predictor, m_time.cpu);
     add_fiber_force(dt, in);
     remove_body_viscosity(dt, in);
+    // implicit_forcing = "increment" keeps u^ before its solve, which a redo takes again with the
+    // iteration's alpha and u_s; the forcing after the solve keeps u~.
+    if (solve_in_redo()) keep_predictor();
     if (m_cfg.implicit) solve_implicit(in);
-    keep_predictor();
+    if (!solve_in_redo()) keep_predictor();
   }
   correct(dt, in, out);
   ++m_time.steps;
@@ -372,11 +375,16 @@ void Solver::redo_step(double dt, const CouplingIn& in, CouplingOut& out) {
   if (m_phase != Phase::redoable || dt != m_dt_prev)
     fsi::fail("fluid::Solver::redo_step: no step of this dt kept for a redo");
   restore_predictor();
+  if (solve_in_redo()) {
+    const PhaseTimer t(m_time.predictor, m_time.cpu);
+    solve_implicit(in);
+  }
   correct(dt, in, out);
   ++m_time.repeats;
 }
 
-// u~, p^n and the clock at the end of the predictor, for coupled iterations (redo_step).
+// u~ (u^ before the increment's solve), p^n and the clock at the end of the predictor, for
+// coupled iterations (redo_step).
 void Solver::keep_predictor() {
   m_phase = m_keep_for_redo ? Phase::redoable : Phase::between_steps;
   if (m_keep_for_redo) {

@@ -160,6 +160,8 @@ class Solver {
   // The face pressures at time t into m_face_p (pressure sides; per row; solver.cpp).
   void face_pressure(double t);
   void keep_predictor();                                                     // solver.cpp
+  // implicit_forcing = "increment": a redo solves the increment again (its forcing is on u^).
+  bool solve_in_redo() const { return m_cfg.implicit && m_cfg.forcing_in_increment; }
   void restore_predictor();                                                  // solver.cpp
   void correct(double dt, const CouplingIn& in, CouplingOut& out);           // solver.cpp
   void sample(const CouplingIn& in, CouplingOut& out) const;                 // solver.cpp
@@ -219,8 +221,8 @@ class Solver {
   // solver's layout (predictor_implicit), until its solve.
   std::array<std::vector<double>, 2> m_rhs;
   // Crank-Nicolson or body_viscosity = "none": u^n (with t^n's boundary values and ghosts) during
-  // the step; Crank-Nicolson: the forcing alpha (u_s - u^) per solid face of the coupling input
-  // (solve_implicit).
+  // the step; implicit_forcing = "increment": the forcing alpha (u_s - u^) per solid face of the
+  // coupling input (solve_implicit).
   Field m_un, m_vn;
   std::array<std::vector<double>, 2> m_pull;
   // body_viscosity = "none": the volume fraction of the step's footprint per u, v face, zero
