@@ -80,7 +80,8 @@ void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
   // Each flux once, on boxes: the corners the faces of f border, the centres between them and
   // their neighbours, and the α those fluxes read (each a_at once). A flux reading a face outside
   // the footprint has φ = 0, and each is the one the difference at a face would compute, so a
-  // face gets the same bits as with its fluxes computed for it alone.
+  // face gets the same bits as with its fluxes computed for it alone. The work is that of the
+  // boxes: bodies far apart on one rank make them span the grid between them.
   if (!f[0].empty() || !f[1].empty()) {
     // Corners: (i, j), (i, j + 1) of a u face; (i, j), (i + 1, j) of a v face.
     Box k = Box::none();
