@@ -55,6 +55,7 @@ bool may_change(const std::string& path) {
 const std::map<std::string, std::string>& legacy_values() {
   static const std::map<std::string, std::string> kLegacy = {
       {"fluid.body_viscosity", "kelvin-voigt"},  // the default until the bodies became elastic
+      {"fluid.implicit_forcing", "after_solve"},  // Crank-Nicolson's default until "increment"
   };
   return kLegacy;
 }

@@ -54,8 +54,9 @@ class FluidPort : public SolverPort {
   virtual proto::GridInfo grid_info() const = 0;
   // One fluid step t^n -> t^n + dt with the coupler's sparse input; fills `out` (f_s on the
   // solid faces, samples of u^(n+1), diagnostics). With s.iteration > 0: the same step again
-  // from the same predictor u~ (and p^n), with new solid velocities: redo the immersed forcing
-  // and the projection only (the fibers' force is the same as in iteration 0). Only a step
+  // from the same predictor (and p^n), with new solid velocities: redo the immersed forcing
+  // and the projection (and a solve that took the forcing, fluid/README.md); the fibers' force
+  // is the same as in iteration 0. Only a step
   // whose iteration 0 came with s.may_repeat = 1 is ever repeated: a port keeps what a redo
   // needs only then.
   virtual void advance(const proto::StepBegin& s, const proto::FluidInput& in,

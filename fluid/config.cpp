@@ -288,9 +288,11 @@ Config read_config(const fsi::SceneTable& f, double dt) {
   c.density = f.positive("density");
   c.viscosity = f.positive("viscosity");
   c.implicit = f.choice("diffusion", {"explicit", "implicit"}, "explicit") == "implicit";
-  if (f.has("implicit_forcing")) {
+  // Crank-Nicolson's forcing, "increment" by default (recorded in the effective scene: the
+  // default was "after_solve" before, common/checkpoint.cpp).
+  if (c.implicit || f.has("implicit_forcing")) {
     c.forcing_in_increment =
-        f.choice("implicit_forcing", {"after_solve", "increment"}, "after_solve") == "increment";
+        f.choice("implicit_forcing", {"after_solve", "increment"}, "increment") == "increment";
     if (!c.implicit)
       f.fail("implicit_forcing",
              fmt::format("= \"{}\" applies to Crank-Nicolson only: set diffusion = \"implicit\" "
@@ -309,9 +311,9 @@ Config read_config(const fsi::SceneTable& f, double dt) {
     c.forcing_time = f.non_negative("forcing_time");
     if (c.implicit && c.forcing_in_increment)
       f.fail("forcing_time", fmt::format("= {} applies to the forcing of the predictor, and "
-                                         "implicit_forcing = \"increment\" forces inside the "
-                                         "solve: remove forcing_time, or set implicit_forcing = "
-                                         "\"after_solve\"",
+                                         "implicit_forcing = \"increment\" (Crank-Nicolson's "
+                                         "default) forces inside the solve: remove forcing_time, "
+                                         "or set implicit_forcing = \"after_solve\"",
                                          c.forcing_time));
   }
   // Only when given: a scene without it keeps its effective scene as it was.

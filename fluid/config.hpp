@@ -74,11 +74,11 @@ struct Config {
   AxisSpec x, y;
   std::array<SideBc, 4> bc;  // left, right, bottom, top
   bool implicit = false;     // Crank-Nicolson diffusion (else explicit AB2)
-  // Crank-Nicolson's immersed forcing: all of it after the solve ("after_solve", the default: the
-  // wall leaks into the body at large lambda), or on the explicit prediction before the solve and
-  // on the covered faces after it ("increment", predictor.cpp: the explicit scheme's wall at any
-  // lambda, but a moving body's coupling holds less: fluid/README.md).
-  bool forcing_in_increment = false;  // fluid.implicit_forcing, default "after_solve"
+  // Crank-Nicolson's immersed forcing: on the explicit prediction before the solve ("increment",
+  // the default; predictor.cpp, forcing.cpp: the explicit scheme's wall at any lambda), or all of
+  // it after the solve ("after_solve", the default before: the wall leaks into the body at large
+  // lambda; fluid/README.md).
+  bool forcing_in_increment = true;  // fluid.implicit_forcing, default "increment"
   // Crank-Nicolson's Helmholtz solves: approximately factored along the grid lines ("factored",
   // the default; factored_solver.hpp: second order, no transform) or exact by transforms
   // ("direct").

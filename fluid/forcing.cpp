@@ -10,7 +10,7 @@ constexpr double kCovered = 1 - 1e-9;
 
 // Immersed solid (paper Eq. 21): f_s = rho_f alpha (u_s - u~) / dt, then u~ += dt f_s / rho_f,
 // i.e. u~ <- (1 - alpha) u~ + alpha u_s, on the solid's faces (the u faces the step solves for:
-// the interior and a pressure side's boundary faces).
+// the interior and a pressure side's boundary faces; Crank-Nicolson has no pressure sides).
 //
 // Crank-Nicolson in increment form (implicit_forcing = "increment", predictor.cpp) forced its
 // explicit prediction before the solve, pull = alpha (u_s - u^), and f_s = rho_f pull / dt: the

@@ -99,8 +99,9 @@ class Solver {
   void end_substeps(double dt, int m, const CouplingIn& in, CouplingOut& out);
   // Coupled iterations: the step just taken again from its predictor u~ and p^n (kept by
   // end_step() while set_keep_for_redo(true), the default), with new solid input: immersed
-  // forcing, projection, samples. The fibers' force and the predictor are not recomputed
-  // (in.fiber_* is ignored). dt must be that of the step.
+  // forcing, projection, samples; Crank-Nicolson with implicit_forcing = "increment" keeps u^
+  // before its solve and solves again. The fibers' force and the explicit prediction are not
+  // recomputed (in.fiber_* is ignored). dt must be that of the step.
   void redo_step(double dt, const CouplingIn& in, CouplingOut& out);
   // Whether end_step() keeps u~, v~ and p^n for a redo (three copies of the grid each step).
   void set_keep_for_redo(bool keep) { m_keep_for_redo = keep; }
@@ -218,7 +219,7 @@ class Solver {
   std::unique_ptr<SlabSolver> m_slab_poisson, m_slab_u, m_slab_v;  // on several ranks
   std::unique_ptr<FactoredSolver> m_fact_u, m_fact_v;  // helmholtz = "factored"
   // Crank-Nicolson: the boundary increment of the step's solve, per component, in the Helmholtz
-  // solver's layout (predictor_implicit), until its solve.
+  // solver's layout (predictor_implicit), until the step's last solve (a redo's, "increment").
   std::array<std::vector<double>, 2> m_rhs;
   // Crank-Nicolson or body_viscosity = "none": u^n (with t^n's boundary values and ghosts) during
   // the step; implicit_forcing = "increment": the forcing alpha (u_s - u^) per solid face of the

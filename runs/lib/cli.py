@@ -21,6 +21,15 @@ def body_viscosity(p, what):
                         "kelvin-voigt), outputs under OUT/.../body-viscosity-X")
 
 
+def implicit_forcing(p, what):
+    """The --implicit-forcing option of a case whose runs WHAT with Crank-Nicolson ([fluid]
+    implicit_forcing written into its scenes; not given: the fluid's default, "increment")."""
+    p.add_argument("--implicit-forcing", choices=("increment", "after_solve"), default=None,
+                   help=f"[fluid] implicit_forcing of {what} (default: not written, the fluid's "
+                        "increment; the tables measured before it became the default are "
+                        "after_solve), outputs under OUT/.../implicit-forcing-X")
+
+
 def ints(text):
     """A comma-separated list of integers, for `type=`."""
     try:

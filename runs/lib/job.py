@@ -8,6 +8,7 @@ Environment (set by `./fsi validate`): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN (d
 import collections
 import json
 import os
+import re
 import resource
 import subprocess
 import sys
@@ -79,12 +80,16 @@ def _children_cpu():
 def same_defaults(folder):
     """Whether a finished run ran with today's defaults of the keys whose default changed: its
     effective scene records them (fluid.body_viscosity since the bodies became elastic by
-    default; before, an unnamed key meant "kelvin-voigt")."""
+    default; before, an unnamed key meant "kelvin-voigt"; fluid.implicit_forcing with
+    Crank-Nicolson since "increment" became its default; before, "after_solve")."""
     path = os.path.join(folder, "scene.effective.toml")
     if not os.path.exists(path):
         return True
     text = open(path).read()
-    return "[fluid]" not in text or "body_viscosity" in text
+    if "[fluid]" not in text:
+        return True
+    crank_nicolson = re.search(r'^diffusion\s*=\s*"implicit"', text, re.M) is not None
+    return "body_viscosity" in text and (not crank_nicolson or "implicit_forcing" in text)
 
 
 def run(name, scene_text, work=None, programs=None, check=True, reuse=False):

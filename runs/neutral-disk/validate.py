@@ -8,12 +8,14 @@ C -> R over the second half of the run, against -shear/2 (a torque-free disk in 
 confinement 2r/H = 0.3 and the deformation make it slightly slower).
 
   validate            rho_s/rho_f = 1 with coupled iterations (the case), centred and off-centre
-                      (y = 0.35), to t = 10; rho_s/rho_f = 1 explicit (must stop at step 1 with a
-                      message); 1.5 iterated and 3 explicit (centred), for comparison
+                      (y = 0.35), to t = 10; rho_s/rho_f = 1 explicit (must stop at its first
+                      loaded step with a message); 1.5 iterated and 3 explicit (centred), for
+                      comparison
   validate --short    rho_s/rho_f = 1 iterated, centred, to t = 2; rho_s/rho_f = 1 explicit (stop)
 Extra scene lines can be appended to every run with FSI_EXTRA_SCENE (e.g. a coupler option).
 Environment (set by ./fsi validate): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN (default mpirun)."""
 import os
+import re
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
@@ -46,9 +48,12 @@ tolerance = 1e-6
 relaxation = 0.5
 reuse = 20
 """
-# The explicit step at rho_s = rho_f must stop at step 1 with this message (a free body without
-# excess mass has no inertia of its own in the explicit step).
-EXPLICIT_EQUAL_MESSAGE = "stiffness matrix is singular at step 1"
+# The explicit step at rho_s = rho_f must stop with this message (a free body without excess
+# mass has no inertia of its own in the explicit step) at the first step that loads the disk:
+# step 2 with Crank-Nicolson's increment forcing (the default), whose explicit prediction inside
+# the disk is still the fluid at rest at step 1; step 1 with implicit_forcing = "after_solve",
+# whose solve carries the walls' motion into the disk within the first step.
+EXPLICIT_EQUAL_MESSAGE = re.compile(r"stiffness matrix is singular at step [12] ")
 # The rotation rate of a stable run within 3 % of -shear/2 (measured -0.4938 at ratio 3, i.e.
 # 1.2 % slow); the drift of the centred disk below 1e-4 radii (symmetry), of the off-centre one
 # reported.
@@ -125,7 +130,7 @@ def main():
 
     for r in rows:
         if r["ratio"] == 1.0 and not r["iterations"]:
-            ok = (not r["completed"]) and EXPLICIT_EQUAL_MESSAGE in r["message"]
+            ok = (not r["completed"]) and EXPLICIT_EQUAL_MESSAGE.search(r["message"]) is not None
             metrics["explicit_equal_density_stops_with_message"] = holds(ok)
         if r["iterations"]:
             key = f"ratio_{r['ratio']:g}_y{r['y0']:g}_iterated"

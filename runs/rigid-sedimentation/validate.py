@@ -7,9 +7,10 @@ of a cylinder between two plane walls (README.md).
                       same nu dt / h^2 = 1.02), rho_s/rho_f = 3 explicit and 1.5 with coupled
                       iterations, to t = 1.5
   validate --short    h = 1/32 only, both density ratios, to t = 1
-  validate --increment [--short]
-                      the default grids and time steps with Crank-Nicolson's forcing in its
-                      increment ([fluid] implicit_forcing = "increment"); summary-increment.json
+  validate --after-solve [--short]
+                      the default grids and time steps with Crank-Nicolson's forcing after its
+                      solve ([fluid] implicit_forcing = "after_solve", the default before
+                      "increment"); summary-after-solve.json
   validate --explicit-diffusion [--short]
                       the same grids with explicit diffusion at nu dt / h^2 = 0.1 (dt = 0.1 h^2),
                       rho_s/rho_f = 3 only; its summary goes to summary-explicit-diffusion.json
@@ -29,12 +30,12 @@ import outputs  # noqa: E402
 PARSER = cli.parser(__doc__)
 PARSER.add_argument("--explicit-diffusion", action="store_true",
                     help="explicit diffusion at nu dt / h^2 = 0.1, rho_s/rho_f = 3 only")
-PARSER.add_argument("--increment", action="store_true",
-                    help='Crank-Nicolson with [fluid] implicit_forcing = "increment"')
+PARSER.add_argument("--after-solve", action="store_true",
+                    help='Crank-Nicolson with [fluid] implicit_forcing = "after_solve"')
 ARGS = PARSER.parse_args()
 SHORT = ARGS.short
 EXPLICIT = ARGS.explicit_diffusion
-INCREMENT = ARGS.increment
+AFTER_SOLVE = ARGS.after_solve
 HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = job.out_dir("rigid-sedimentation")
 
@@ -83,9 +84,9 @@ def scene(n, ratio, iterate):
         text = text.replace("dt = 1e-3", f"dt = {0.1 / (MU * n * n):.10g}")
     else:
         text = text.replace("dt = 1e-3", f"dt = {1e-3 * (32 / n) ** 2:g}")
-        if INCREMENT:
+        if AFTER_SOLVE:
             text = text.replace('diffusion = "implicit"',
-                                'diffusion = "implicit"\nimplicit_forcing = "increment"')
+                                'diffusion = "implicit"\nimplicit_forcing = "after_solve"')
     return text + (ITERATIONS if iterate else "")
 
 
@@ -93,7 +94,7 @@ def main():
     rows, metrics = [], {}
     for n in GRIDS:
         for ratio, iterate in RATIOS:
-            name = (("diffusion-explicit-" if EXPLICIT else "increment-" if INCREMENT else "")
+            name = (("diffusion-explicit-" if EXPLICIT else "after-solve-" if AFTER_SOLVE else "")
                     + f"h{n}-ratio-{ratio:g}-{'iter' if iterate else 'explicit'}")
             r = job.run(name, scene(n, ratio, iterate), check=False)
             row = {"cells_per_length": n, "ratio": ratio, "iterations": iterate,
@@ -134,7 +135,7 @@ def main():
                                  if row["completed"] else f"stopped: {row['message']}"), flush=True)
     finish("rigid-sedimentation", metrics, {"runs": rows}, short=SHORT,
            name="summary-explicit-diffusion.json" if EXPLICIT
-           else "summary-increment.json" if INCREMENT else "summary.json")
+           else "summary-after-solve.json" if AFTER_SOLVE else "summary.json")
 
 
 if __name__ == "__main__":

@@ -13,7 +13,7 @@ side). At rest, u^(n+1) = u^n gives alpha u = (1 - alpha) dt R: the cell holds a
 (1 - alpha) dt R / alpha. How much of the cell is blocked depends on alpha against
 lambda = nu dt / h^2, the fluid's own relaxation in one step, so the case runs at
 lambda = 0.02 (FSI1's L2 level: nu = 1e-3, dt = 5e-4, h = 5e-3) and 0.1 with explicit diffusion,
-and 0.128, 0.5, 2 with Crank-Nicolson, its forcing after the solve (the default) and in its
+and 0.128, 0.5, 2 with Crank-Nicolson, its forcing after the solve (the default before) and in its
 increment ([fluid] implicit_forcing = "increment"; also at 4, 6 and 8 with the factored solve).
 
 For each lambda the largest offset |e - y0| / h is judged against the tolerance in TOL_OFFSET
@@ -42,8 +42,8 @@ N = 16           # cells across the channel (height 1); the exact profile is lin
 H = 1.0 / N
 DT = 1e-3
 # (lambda, diffusion, [fluid] implicit_forcing, [fluid] helmholtz): the forcing after the
-# Crank-Nicolson solve (the default) and in its increment, with the direct Helmholtz solve, and the
-# increment with the factored one.
+# Crank-Nicolson solve (the default before) and in its increment (the default), with the direct
+# Helmholtz solve, and the increment with the factored one.
 CASES = [(0.02, "explicit", None, None), (0.1, "explicit", None, None),
          (0.128, "implicit", "after_solve", "direct"), (0.5, "implicit", "after_solve", "direct"),
          (2.0, "implicit", "after_solve", "direct"),

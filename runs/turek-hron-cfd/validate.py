@@ -20,6 +20,9 @@ runs with the direct solve are named *-direct.
 `--body-viscosity none|kelvin-voigt`: fluid.body_viscosity written into the scenes (none, the
 fluid's default: the mixture stress on the cut faces, fluid/README.md; kelvin-voigt: the model
 of the README's tables), every output under OUT/body-viscosity-X.
+`--implicit-forcing increment|after_solve`: fluid.implicit_forcing written into the scenes
+(increment, the fluid's default; after_solve: the forcing of the tables measured before it), every
+output under OUT/implicit-forcing-X; `--forcing-time` writes after_solve (it blends that forcing).
 Environment (set by `./fsi validate`): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN."""
 import glob
 import json
@@ -58,13 +61,20 @@ _p.add_argument("--cases", nargs="+", choices=["cfd1", "cfd2"], default=["cfd1",
 _p.add_argument("--helmholtz", choices=["direct", "factored"], default="factored",
                 help="fluid.helmholtz of the scenes (Crank-Nicolson's Helmholtz solves)")
 cli.body_viscosity(_p, "the scenes")
+cli.implicit_forcing(_p, "the scenes")
 ARGS = _p.parse_args()
 if ARGS.forcing_time is not None and not ARGS.bands_xy:
     _p.error("--forcing-time goes with --bands-xy (the other modes' files are not named by it)")
 SHORT, REUSE = ARGS.short, ARGS.reuse
 HERE = os.path.dirname(os.path.abspath(__file__))
 job.out_dir("turek-hron-cfd")
-OUT = job.nest(ARGS.body_viscosity and f"body-viscosity-{ARGS.body_viscosity}")
+OUT = job.nest(ARGS.body_viscosity and f"body-viscosity-{ARGS.body_viscosity}",
+               ARGS.implicit_forcing and f"implicit-forcing-{ARGS.implicit_forcing}")
+# fluid.forcing_time blends the forcing of the predictor, which the Crank-Nicolson default
+# ("increment") does not take: a forcing time runs the forcing after the solve.
+FORCING = "after_solve" if ARGS.forcing_time is not None else ARGS.implicit_forcing
+if ARGS.forcing_time is not None and ARGS.implicit_forcing == "increment":
+    _p.error("--forcing-time takes the forcing after the solve: drop --implicit-forcing increment")
 
 H, L = 0.41, 2.5
 TAU_TAG = "" if ARGS.forcing_time is None else f"-tau{ARGS.forcing_time:g}"
@@ -139,6 +149,8 @@ def scene_text(case, n, dt=None, band=None, name=None, x_band=None, columns=None
                 line += f"\nforcing_time = {ARGS.forcing_time!r}"
             if ARGS.body_viscosity is not None:
                 line += f'\nbody_viscosity = "{ARGS.body_viscosity}"'
+            if FORCING is not None:
+                line += f'\nimplicit_forcing = "{FORCING}"'
         lines.append(line)
     assert not replace, f"scene {case}.toml lacks keys {list(replace)}"
     return "\n".join(lines) + "\n", dt

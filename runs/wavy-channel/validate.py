@@ -141,6 +141,7 @@ interval = {INTERVAL}
 density = {RHO_F}
 viscosity = {MU}
 diffusion = "implicit"
+implicit_forcing = "after_solve"
 body_viscosity = "kelvin-voigt"
 [fluid.grid]
 cells = [{n}, {n // 2}]

@@ -56,6 +56,13 @@ TEST_CASE("a key recorded since its default changed: absent counts as its old va
   CHECK(changed_physics_key(kScene, with("\"none\"")) == "fluid.body_viscosity");
   CHECK(changed_physics_key(with("\"none\""), with("\"kelvin-voigt\"")) == "fluid.body_viscosity");
   CHECK(changed_physics_key(with("\"kelvin-voigt\""), kScene) == "fluid.body_viscosity");
+  // Crank-Nicolson's forcing, recorded since its default became "increment".
+  const auto forcing = [&](const char* v) {
+    return replaced(kScene, "viscosity = 0.01",
+                    std::string("viscosity = 0.01\nimplicit_forcing = ") + v);
+  };
+  CHECK(changed_physics_key(kScene, forcing("\"after_solve\"")).empty());
+  CHECK(changed_physics_key(kScene, forcing("\"increment\"")) == "fluid.implicit_forcing");
   // Any other key added at a restart still counts.
   CHECK(changed_physics_key(kScene, replaced(kScene, "viscosity = 0.01", "viscosity = 0.01\nforcing_time = 0.0")) ==
         "fluid.forcing_time");

@@ -139,7 +139,11 @@ TEST_CASE("forcing_time: read, refused negative or with the increment forcing",
   CHECK(read(kGood).forcing_time < 0);  // not given: tau = dt
   CHECK(read(with("forcing_time = 2e-4")).forcing_time == 2e-4);
   CHECK(read(with("forcing_time = 0")).forcing_time == 0.0);
-  CHECK(read(with("diffusion = \"implicit\"\nforcing_time = 1e-3")).forcing_time == 1e-3);
+  const std::string after_solve = "diffusion = \"implicit\"\nimplicit_forcing = \"after_solve\"";
+  CHECK(read(with(after_solve + "\nforcing_time = 1e-3")).forcing_time == 1e-3);
+  // Crank-Nicolson's default forcing is inside its solve: the key must name "after_solve".
+  CHECK_THROWS_WITH(read(with("diffusion = \"implicit\"\nforcing_time = 1e-3")),
+                    Contains("forcing_time") && Contains("after_solve"));
   CHECK_THROWS_WITH(read(with("forcing_time = -1e-3")),
                     Contains("forcing_time") && Contains("-0.001"));
   CHECK_THROWS_WITH(read(with("forcing_time = inf")), Contains("forcing_time") && Contains("inf"));
@@ -151,9 +155,10 @@ TEST_CASE("forcing_time: read, refused negative or with the increment forcing",
 TEST_CASE("implicit_forcing: read with Crank-Nicolson, refused without it or unknown",
           "[fluid][config][implicit]") {
   const std::string cn = replace(kGood, "viscosity = 0.01", "viscosity = 0.01\ndiffusion = \"implicit\"");
-  CHECK_FALSE(read(cn).forcing_in_increment);  // "after_solve" by default
-  CHECK(read(replace(cn, "viscosity = 0.01", "viscosity = 0.01\nimplicit_forcing = \"increment\""))
-            .forcing_in_increment);
+  CHECK(read(cn).forcing_in_increment);  // "increment" by default
+  CHECK_FALSE(
+      read(replace(cn, "viscosity = 0.01", "viscosity = 0.01\nimplicit_forcing = \"after_solve\""))
+          .forcing_in_increment);
   CHECK_THROWS_WITH(
       read(replace(cn, "viscosity = 0.01", "viscosity = 0.01\nimplicit_forcing = \"inside\"")),
       Contains("implicit_forcing") && Contains("inside"));
