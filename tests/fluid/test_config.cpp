@@ -27,11 +27,16 @@ bottom = { type = "wall" }
 top = { type = "wall" }
 )";
 
-fluid::Config read(const std::string& text, double dt = 1e-3) {
-  // In the temporary folder: a run of this binary from a source tree leaves nothing there.
+// TEXT as a scene file, in the temporary folder: a run of this binary from a source tree leaves
+// nothing there.
+std::string scene_file(const std::string& text) {
   const std::string path = (std::filesystem::temp_directory_path() / "fluid_config_test.toml").string();
   std::ofstream(path) << text;
-  fsi::Scene scene(path);
+  return path;
+}
+
+fluid::Config read(const std::string& text, double dt = 1e-3) {
+  fsi::Scene scene(scene_file(text));
   return fluid::read_config(scene.root().table("fluid"), dt);
 }
 
@@ -189,6 +194,20 @@ TEST_CASE("helmholtz: factored by default, direct with Crank-Nicolson, refused o
       Contains("time.dt = 1") && Contains("nu dt / h^2 < 2"));
   CHECK_NOTHROW(
       read(replace(walls, "viscosity = 0.01", "viscosity = 0.01\nhelmholtz = \"direct\""), 0.5));
+}
+
+// Whether the effective scene of TEXT records fluid.implicit_forcing (a restart and the case
+// scripts tell the defaults of a run by it: common/checkpoint.cpp, runs/lib/job.py).
+bool records_implicit_forcing(const std::string& text) {
+  fsi::Scene scene(scene_file(text));
+  fluid::read_config(scene.root().table("fluid"), 1e-3);
+  return scene.effective_toml().find("implicit_forcing = \"increment\"") != std::string::npos;
+}
+
+TEST_CASE("implicit_forcing: its default recorded with Crank-Nicolson only", "[fluid][config]") {
+  CHECK(records_implicit_forcing(
+      replace(kGood, "viscosity = 0.01", "viscosity = 0.01\ndiffusion = \"implicit\"")));
+  CHECK_FALSE(records_implicit_forcing(kGood));
 }
 
 TEST_CASE("body_viscosity: none by default, kelvin-voigt, refused when unknown",
