@@ -64,13 +64,14 @@ struct Patch {
     w = b.i1 - b.i0 + 1;
     v.resize(std::size_t(w) * std::size_t(b.j1 - b.j0 + 1));
   }
-  double& operator()(int i, int j) {
+  double& operator()(int i, int j) { return v[at(i, j)]; }
+  double operator()(int i, int j) const { return v[at(i, j)]; }
+
+ private:
+  // Offset of (i, j) in v (checked in debug builds).
+  std::size_t at(int i, int j) const {
     FSI_ASSERT(i >= box.i0 && i <= box.i1 && j >= box.j0 && j <= box.j1);
-    return v[std::size_t(i - box.i0) + std::size_t(w) * std::size_t(j - box.j0)];
-  }
-  double operator()(int i, int j) const {
-    FSI_ASSERT(i >= box.i0 && i <= box.i1 && j >= box.j0 && j <= box.j1);
-    return v[std::size_t(i - box.i0) + std::size_t(w) * std::size_t(j - box.j0)];
+    return std::size_t(i - box.i0) + std::size_t(w) * std::size_t(j - box.j0);
   }
 };
 
