@@ -50,10 +50,13 @@ void get_list(Reader& r, std::vector<std::vector<T>>& l) {
   l.resize(static_cast<std::size_t>(n));
   for (auto& v : l) r.get(v);
 }
-void put(Writer& w, const FaceSolid& f) { w.put(f.index), w.put(f.alpha), w.put(f.velocity); }
+void put(Writer& w, const FaceSolid& f) {
+  w.put(f.index), w.put(f.alpha), w.put(f.velocity), w.put(f.elastic);
+}
 void get(Reader& r, FaceSolid& f) {
-  r.get(f.index), r.get(f.alpha), r.get(f.velocity);
-  if (f.alpha.size() != f.index.size() || f.velocity.size() != f.index.size())
+  r.get(f.index), r.get(f.alpha), r.get(f.velocity), r.get(f.elastic);
+  if (f.alpha.size() != f.index.size() || f.velocity.size() != f.index.size() ||
+      (!f.elastic.empty() && f.elastic.size() != f.index.size()))
     fail("protocol error: face solid arrays of different lengths");
 }
 void put(Writer& w, const FaceForce& f) { w.put(f.index), w.put(f.force); }

@@ -19,7 +19,7 @@
 namespace fsi::proto {
 
 // Bump on any change of a message's layout or of the message order.
-inline constexpr std::int32_t kVersion = 7;
+inline constexpr std::int32_t kVersion = 8;
 inline constexpr std::uint32_t kMagic = 0x4d495346;  // "FSIM"
 
 // The fluid on several ranks: its ny cell rows in blocks of this many, rank r holding rows
@@ -212,11 +212,15 @@ struct StepBegin {  // coupler -> each solver, every step
 };
 
 // Solid on faces: for each listed face, the solid volume fraction alpha in [0, 1] of its
-// control volume and the mean solid velocity component over the solid part of it.
+// control volume and the mean solid velocity component over the solid part of it. Since
+// version 8, elastic: the part of alpha that belongs to elastic bodies (kind 0), in the same
+// order, which is where the fluid takes its viscosity out of the bodies (fluid.body_viscosity
+// = "none"); empty when every body of the scene is elastic (then it is alpha).
 struct FaceSolid {
   std::vector<std::int32_t> index;
   std::vector<double> alpha;
   std::vector<double> velocity;
+  std::vector<double> elastic;
 };
 
 // A sparse body force per unit volume on faces (force on the fluid).

@@ -61,13 +61,16 @@ void FluidRanks::split(const proto::FluidInput& in) {
     std::vector<proto::FaceSolid*> parts(P);
     for (int r = 0; r < P; ++r) parts[r] = comp == 0 ? &m_parts[r].solid_u : &m_parts[r].solid_v;
     std::vector<std::vector<std::int32_t>*> idx(P);
-    std::vector<std::vector<double>*> alpha(P), vel(P);
-    for (int r = 0; r < P; ++r)
+    std::vector<std::vector<double>*> alpha(P), vel(P), elastic(P);
+    for (int r = 0; r < P; ++r) {
       idx[r] = &parts[r]->index, alpha[r] = &parts[r]->alpha, vel[r] = &parts[r]->velocity;
+      elastic[r] = &parts[r]->elastic;
+    }
     if (comp == 0) split_list(s.index, u, m_rank[0], idx);
     else split_list(s.index, v, m_rank[1], idx);
     split_values(s.alpha, m_rank[comp], alpha);
     split_values(s.velocity, m_rank[comp], vel);
+    split_values(s.elastic, m_rank[comp], elastic);  // empty stays empty on every rank
     // The fibers' force: no answer, its ranks are not kept.
     const proto::FaceForce& f = comp == 0 ? in.force_u : in.force_v;
     std::vector<int> frank;

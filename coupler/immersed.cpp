@@ -137,6 +137,7 @@ ImmersedSolid::ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshe
   m_scratch_u.slot.assign(static_cast<std::size_t>(m_uf.faces.ni * m_uf.faces.nj), -1);
   m_scratch_v.slot.assign(static_cast<std::size_t>(m_vf.faces.ni * m_vf.faces.nj), -1);
   m_threads = std::thread::hardware_concurrency() > 1;
+  for (const auto& b : meshes.bodies) m_any_rigid |= b.kind != proto::BodyKind::elastic;
 }
 
 // Every triangle of body b at positions x, against every box its bounding box meets (and its
@@ -362,6 +363,15 @@ void ImmersedSolid::gather(const Fixed& fixed, const Raw& moving, Faces& p, Scra
     p.slot_moving[e] = slot[moving[e].face];
     p.area[p.slot_moving[e]] += moving[e].area();
   }
+  // The elastic bodies' part (the fixed pieces are all rigid): where the fluid may take its
+  // viscosity out of a body, which a rigid one does not need (no strain inside) and which moves
+  // a rigid wall the flow sees into the body (runs/sub-cell-wall).
+  if (m_any_rigid) {
+    p.elastic_area.assign(nf, 0.0);
+    for (std::size_t e = 0; e < moving.size(); ++e)
+      if (m_meshes.bodies[moving[e].body].kind == proto::BodyKind::elastic)
+        p.elastic_area[p.slot_moving[e]] += moving[e].area();
+  }
   p.total_area = 0;
   for (std::size_t k = 0; k < nf; ++k) {
     p.total_area += p.area[k];
@@ -395,10 +405,12 @@ void ImmersedSolid::fill(const Family& fam, const Faces& p, const proto::SolidSt
   out.index = p.face;
   out.alpha.resize(nf);
   out.velocity.resize(nf);
+  out.elastic.resize(m_any_rigid ? nf : 0);
   for (std::size_t k = 0; k < nf; ++k) {
     const int i = p.face[k] % boxes.ni, j = p.face[k] / boxes.ni;
     out.alpha[k] = std::min(1.0, p.area[k] / boxes.volume(i, j));
     out.velocity[k] = p.sum[k] / p.area[k];
+    if (m_any_rigid) out.elastic[k] = std::min(1.0, p.elastic_area[k] / boxes.volume(i, j));
   }
 }
 

@@ -147,6 +147,7 @@ class ImmersedSolid {
   struct Faces {
     std::vector<std::int32_t> face;
     std::vector<double> area;            // Σ |V ∩ T| of the face
+    std::vector<double> elastic_area;    // the same over elastic bodies' T (m_any_rigid only)
     std::vector<std::int32_t> slot_moving;
     std::vector<std::int32_t> slot_fixed_face;  // per face of Fixed::face
     const Fixed* fixed = nullptr;
@@ -193,6 +194,8 @@ class ImmersedSolid {
   alignas(kLine) Scratch m_scratch_u;
   alignas(kLine) Scratch m_scratch_v;
   bool m_fixed_done = false;  // set after both threads are done
+  // Some body is not elastic: FaceSolid::elastic is sent (protocol version 8), else left empty.
+  bool m_any_rigid = false;
   bool m_threads = false;  // the two families on two threads (more than one core)
 };
 

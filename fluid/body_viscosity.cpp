@@ -36,9 +36,23 @@ namespace fluid {
 // with explicit diffusion a step whose footprint has faces after a step without any did not
 // keep uⁿ and keeps the viscosity inside the bodies that once (a body entering the grid; bodies
 // there from the start have faces at the first step; Crank-Nicolson always keeps uⁿ).
+//
+// Only elastic bodies lose the viscosity: the coupler's α of the elastic bodies alone (CouplingIn
+// solid_*_elastic; α itself when every body is elastic). A rigid body has no strain inside, so
+// the correction would touch only its surface, where it moves the wall the flow sees up to a
+// third of a cell further into the body (runs/sub-cell-wall); a rigid body keeps the fluid's
+// viscosity, which is the same rigid body.
 void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
   if (!m_cfg.bodies_inviscid) return;
-  const bool here = !in.solid_u_index.empty() || !in.solid_v_index.empty();
+  const std::span<const std::int32_t> idx[2] = {in.solid_u_index, in.solid_v_index};
+  const bool mixed = !in.solid_u_elastic.empty() || !in.solid_v_elastic.empty();
+  const std::span<const double> alpha[2] = {mixed ? in.solid_u_elastic : in.solid_u_alpha,
+                                            mixed ? in.solid_v_elastic : in.solid_v_alpha};
+  // Whether this rank has faces of an elastic body.
+  bool here = false;
+  for (int c = 0; c < 2; ++c)
+    here |= mixed ? std::any_of(alpha[c].begin(), alpha[c].end(), [](double a) { return a > 0; })
+                  : !idx[c].empty();
   m_body_faces = m_dec.serial() ? here : m_dec.sum(here ? 1.0 : 0.0) > 0;
   if (!m_body_faces || !m_un_kept) return;
   const int nx = m_grid.nx(), ny = m_grid.ny();
@@ -55,8 +69,6 @@ void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
   const int ni[2] = {px ? nx : nx + 1, nx}, nj[2] = {ny, py ? ny : ny + 1};
   const int i_lo[2] = {m_i0, 0}, i_hi[2] = {nx, nx};
   const int j_lo[2] = {0, m_j0}, j_hi[2] = {ny, ny};
-  const std::span<const std::int32_t> idx[2] = {in.solid_u_index, in.solid_v_index};
-  const std::span<const double> alpha[2] = {in.solid_u_alpha, in.solid_v_alpha};
   auto wrap = [](int k, int n, bool periodic) { return periodic ? (k + n) % n : k; };
   // α of face (i, j) of family c for the minima: 1 (no say) beyond a wall or on a boundary face.
   const bool wrap_y = py && m_dec.serial();
@@ -71,6 +83,7 @@ void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
   for (int c = 0; c < 2; ++c)
     for (std::size_t q = 0; q < idx[c].size(); ++q) {
       const auto [i, j] = face_of(c, idx[c][q]);
+      if (!(alpha[c][q] > 0)) continue;  // a rigid body's face
       double& a = m_body_alpha[c](i, owned(j, c));
       a = std::min(1.0, a + alpha[c][q]);
       if (i >= i_lo[c] && i < i_hi[c] && j >= j_lo[c] && j < j_hi[c]) f[c].join({i, i, j, j});

@@ -46,7 +46,8 @@ void Solver::save(fsi::H5File* h5) const {
   if (!h5) return;
   h5->write("fluid/clock", std::vector<double>{m_t, m_dt_prev});
   h5->write("fluid/step", std::vector<std::int64_t>{m_step});
-  // whether the last step's footprint had faces (the next step keeps uⁿ for body_viscosity)
+  // whether the last step's footprint had elastic faces (the next step keeps uⁿ for
+  // body_viscosity)
   h5->write("fluid/body_faces", std::vector<std::int64_t>{m_body_faces ? 1 : 0});
 }
 

@@ -84,7 +84,8 @@ struct Config {
   // ("direct").
   bool factored_helmholtz = true;  // fluid.helmholtz
   // fluid.body_viscosity = "none" (the default): the fluid's viscous stress weighted by 1 − φ
-  // (φ the bodies' volume fraction), so that bodies are purely elastic (body_viscosity.cpp);
+  // (φ the elastic bodies' volume fraction), so that bodies are purely elastic; rigid bodies
+  // keep it, which changes nothing inside them (body_viscosity.cpp);
   // "kelvin-voigt": the fluid's viscosity everywhere, bodies are Kelvin-Voigt with μ_s = μ_f.
   bool bodies_inviscid = true;
   // fluid.forcing_time tau >= 0: the immersed forcing's relaxation time (forcing.cpp). A face of

@@ -122,6 +122,8 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
   c.solid_v_index = in.solid_v.index;
   c.solid_v_alpha = in.solid_v.alpha;
   c.solid_v_velocity = in.solid_v.velocity;
+  c.solid_u_elastic = in.solid_u.elastic;
+  c.solid_v_elastic = in.solid_v.elastic;
   c.fiber_u_index = in.force_u.index;
   c.fiber_u_force = in.force_u.force;
   c.fiber_v_index = in.force_v.index;

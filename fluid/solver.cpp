@@ -305,7 +305,7 @@ void Solver::begin_step(double dt) {
     explicit_terms();
   }
   // u^n with t^n's boundary values and ghosts (predictor_implicit; remove_body_viscosity, while
-  // the footprint has faces: a scene without bodies does not pay for the copy)
+  // the footprint has elastic faces: a scene without elastic bodies does not pay for the copy)
   m_un_kept = m_cfg.implicit || (m_cfg.bodies_inviscid && m_body_faces);
   if (m_un_kept) {
     const PhaseTimer t(m_time.predictor, m_time.cpu);

@@ -41,6 +41,9 @@ namespace fluid {
 struct CouplingIn {
   std::span<const std::int32_t> solid_u_index, solid_v_index;
   std::span<const double> solid_u_alpha, solid_u_velocity, solid_v_alpha, solid_v_velocity;
+  // The part of alpha that belongs to elastic bodies, in the same order, where body_viscosity =
+  // "none" takes the viscosity out; empty when every body is elastic (then alpha).
+  std::span<const double> solid_u_elastic, solid_v_elastic;
   std::span<const std::int32_t> fiber_u_index, fiber_v_index;
   std::span<const double> fiber_u_force, fiber_v_force;
   std::span<const std::int32_t> sample_u_index, sample_v_index;
@@ -226,15 +229,16 @@ class Solver {
   // coupling input (solve_implicit).
   Field m_un, m_vn;
   std::array<std::vector<double>, 2> m_pull;
-  // body_viscosity = "none": the volume fraction of the step's footprint per u, v face, zero
+  // body_viscosity = "none": the elastic bodies' volume fraction per u, v face, zero
   // between steps; the step's α, centre fluxes (u, v) and corner fluxes on their boxes
   // (body_viscosity.cpp).
   std::array<Field, 2> m_body_alpha;
   std::array<Patch, 2> m_bv_phi, m_bv_centre;
   Patch m_bv_corner;
-  // body_viscosity = "none": whether the last step's footprint had faces on any rank (true
-  // before the first step; a checkpoint keeps it), and whether this step kept uⁿ in m_un, m_vn
-  // (begin_step keeps it for the correction only while there are bodies; Crank-Nicolson always).
+  // body_viscosity = "none": whether the last step's footprint had faces of an elastic body on
+  // any rank (true before the first step; a checkpoint keeps it), and whether this step kept uⁿ
+  // in m_un, m_vn (begin_step keeps it for the correction only while there are elastic bodies;
+  // Crank-Nicolson always).
   bool m_body_faces = true;
   bool m_un_kept = false;
   std::array<std::vector<double>, 2> m_force_sum;  // end_substeps: the solid force's sums

@@ -55,14 +55,17 @@ TEST_CASE("every message survives a round trip") {
   CHECK(sb2.action == Action::stop);
 
   FluidInput fi;
-  fi.solid_u = {{1, 5, 9}, {0.5, 1.0, 0.25}, {0.1, 0.2, 0.3}};
+  fi.solid_u = {{1, 5, 9}, {0.5, 1.0, 0.25}, {0.1, 0.2, 0.3}, {0.5, 0.0, 0.125}};
+  fi.solid_v = {{2}, {0.75}, {-0.1}, {}};  // every body elastic: no separate fraction
   fi.force_v = {{4}, {-2.5}};
   fi.sample_u = {3, 4};
   fi.sample_p = {7};
   const auto fi2 = round_trip(fi);
   CHECK(fi2.solid_u.index == fi.solid_u.index);
   CHECK(fi2.solid_u.velocity == fi.solid_u.velocity);
-  CHECK(fi2.solid_v.index.empty());
+  CHECK(fi2.solid_u.elastic == fi.solid_u.elastic);
+  CHECK(fi2.solid_v.index == fi.solid_v.index);
+  CHECK(fi2.solid_v.elastic.empty());
   CHECK(fi2.force_v.force == fi.force_v.force);
   CHECK(fi2.sample_u == fi.sample_u);
   CHECK(fi2.sample_p == fi.sample_p);
@@ -99,6 +102,13 @@ TEST_CASE("damaged or mismatched messages are refused") {
     FluidInput fi;
     CHECK_THROWS_WITH(unpack_message(bytes, fi),
                       Catch::Contains("expected message 'fluid_input', got 'step_begin'"));
+  }
+  SECTION("an elastic fraction for some faces only") {
+    FluidInput fi;
+    fi.solid_u = {{1, 5}, {0.5, 1.0}, {0.1, 0.2}, {0.5}};
+    FluidInput back;
+    CHECK_THROWS_WITH(unpack_message(pack_message(fi, 1), back),
+                      Catch::Contains("face solid arrays of different lengths"));
   }
   SECTION("another protocol version") {
     Header h;

@@ -403,6 +403,61 @@ TEST_CASE("overlapping bodies: alpha capped at 1, the mean velocity weighted by 
   CHECK(std::abs(b.fy) <= 1e-12 * b.scale);
 }
 
+// The elastic bodies' part of α (protocol version 8), where the fluid takes its viscosity out of
+// the bodies: none sent while every body is elastic; with a rigid body (fixed or moving) that
+// overlaps an elastic one, min(1, |CV ∩ elastic|/|CV|) on every face, the elastic body's exact
+// outline clipped as reference, on faces of either body alone and of both.
+TEST_CASE("the elastic part of alpha: empty when all bodies are elastic, else theirs alone") {
+  const auto g = grid(24, 20, 1.2, 1.0, false, false);
+  proto::BodyMeshes m;
+  const double theta = 0.2, w = 0.5, h = 0.4;
+  const Vec2 c{0.45, 0.45};
+  m.bodies.push_back(rectangle(w, h, 9, 7, theta, c));
+  m.bodies.push_back(rectangle(0.45, 0.35, 9, 7, 0.0, {0.7, 0.55}));
+  std::vector<Vec2> elastic;  // the first body's outline
+  for (auto [sx, sy] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}})
+    elastic.push_back({c.x + std::cos(theta) * sx * w / 2 - std::sin(theta) * sy * h / 2,
+                       c.y + std::sin(theta) * sx * w / 2 + std::cos(theta) * sy * h / 2});
+  const std::vector<Vec2> rigid = {{0.475, 0.375}, {0.925, 0.375}, {0.925, 0.725}, {0.475, 0.725}};
+  const auto s = at_rest(m);
+  {
+    ImmersedSolid all_elastic(g, m);
+    proto::FaceSolid u, v;
+    all_elastic.update(s, u, v);
+    CHECK(!u.index.empty());
+    CHECK(u.elastic.empty());
+    CHECK(v.elastic.empty());
+  }
+  for (const auto kind : {proto::BodyKind::rigid_fixed, proto::BodyKind::rigid_moving}) {
+    m.bodies[1].kind = kind;
+    ImmersedSolid is(g, m);
+    proto::FaceSolid u, v;
+    is.update(s, u, v);
+    for (int comp = 0; comp < 2; ++comp) {
+      const auto boxes = comp == 0 ? FaceBoxes::u_faces(g) : FaceBoxes::v_faces(g);
+      const auto& fs = comp == 0 ? u : v;
+      REQUIRE(fs.elastic.size() == fs.index.size());
+      int rigid_only = 0, elastic_only = 0, both = 0;
+      for (std::size_t k = 0; k < fs.index.size(); ++k) {
+        const int i = fs.index[k] % boxes.ni, j = fs.index[k] / boxes.ni;
+        auto area = [&](const std::vector<Vec2>& outline) {
+          const auto p = clip_convex(outline, boxes.ex[i], boxes.ex[i + 1], boxes.ey[j],
+                                     boxes.ey[j + 1]);
+          return p.empty() ? 0.0 : polygon_moments(p.data(), static_cast<int>(p.size())).area;
+        };
+        const double vol = boxes.volume(i, j), a_el = area(elastic), a_rigid = area(rigid);
+        CHECK(std::abs(fs.elastic[k] - std::min(1.0, a_el / vol)) <= 1e-13);
+        CHECK(fs.elastic[k] <= fs.alpha[k]);
+        const bool e = a_el > 1e-12 * vol, r = a_rigid > 1e-12 * vol;
+        both += e && r, rigid_only += r && !e, elastic_only += e && !r;
+      }
+      CHECK(rigid_only > 5);
+      CHECK(elastic_only > 5);
+      CHECK(both > 5);
+    }
+  }
+}
+
 // The smoothed footprint (`[coupler] footprint_smoothing = ε`): each face's weight is its box
 // convolved with a box of width ε h, a partition of unity; ε = 1 on a uniform grid is the tent of
 // width 2h.
