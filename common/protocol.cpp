@@ -77,7 +77,8 @@ void GridInfo::unpack(Reader& r) {
 
 void BodyMeshes::pack(Writer& w) const {
   w.put(static_cast<std::int64_t>(bodies.size()));
-  for (const auto& b : bodies) w.put(b.name), w.put(b.kind), w.put(b.x_ref), w.put(b.tri), w.put(b.edges);
+  for (const auto& b : bodies)
+    w.put(b.name), w.put(b.kind), w.put(b.x_ref), w.put(b.tri), w.put(b.edges), w.put(b.rigid);
   w.put(can_iterate);
 }
 void BodyMeshes::unpack(Reader& r) {
@@ -86,10 +87,12 @@ void BodyMeshes::unpack(Reader& r) {
   if (n < 0 || n > (1 << 20)) fail("protocol error: body count {} out of range", n);
   bodies.resize(static_cast<std::size_t>(n));
   for (auto& b : bodies) {
-    r.get(b.name), r.get(b.kind), r.get(b.x_ref), r.get(b.tri), r.get(b.edges);
+    r.get(b.name), r.get(b.kind), r.get(b.x_ref), r.get(b.tri), r.get(b.edges), r.get(b.rigid);
     const auto k = static_cast<std::int32_t>(b.kind);
     if (k < 0 || k > static_cast<std::int32_t>(BodyKind::rigid_moving))
       fail("protocol error: body '{}' has kind {}, not 0, 1 or 2", b.name, k);
+    if (b.rigid != 0 && b.rigid != 1)
+      fail("protocol error: body '{}' has rigid = {}, not 0 or 1", b.name, b.rigid);
   }
   r.get(can_iterate);
 }

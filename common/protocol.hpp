@@ -153,6 +153,10 @@ struct BodyMesh {
   std::vector<double> x_ref;       // reference node coordinates, 2 per node
   std::vector<std::int32_t> tri;   // 3 node indices per triangle, counter-clockwise
   std::vector<std::int32_t> edges; // surface edges, 2 node indices each, body on the left
+  // Since version 8: 1 when the body moves without strain (a free rigid body, which is kind 0
+  // for the coupler); bodies of kind 1 and 2 are rigid whatever it says. A rigid body keeps the
+  // fluid's viscosity under fluid.body_viscosity = "none" (FaceSolid::elastic).
+  std::int32_t rigid = 0;
 };
 
 struct BodyMeshes {  // solid -> coupler, once
@@ -213,7 +217,7 @@ struct StepBegin {  // coupler -> each solver, every step
 
 // Solid on faces: for each listed face, the solid volume fraction alpha in [0, 1] of its
 // control volume and the mean solid velocity component over the solid part of it. Since
-// version 8, elastic: the part of alpha that belongs to elastic bodies (kind 0), in the same
+// version 8, elastic: the part of alpha that belongs to elastic bodies (kind 0, not rigid), in the same
 // order, which is where the fluid takes its viscosity out of the bodies (fluid.body_viscosity
 // = "none"); empty when every body of the scene is elastic (then it is alpha).
 struct FaceSolid {

@@ -137,7 +137,7 @@ ImmersedSolid::ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshe
   m_scratch_u.slot.assign(static_cast<std::size_t>(m_uf.faces.ni * m_uf.faces.nj), -1);
   m_scratch_v.slot.assign(static_cast<std::size_t>(m_vf.faces.ni * m_vf.faces.nj), -1);
   m_threads = std::thread::hardware_concurrency() > 1;
-  for (const auto& b : meshes.bodies) m_any_rigid |= b.kind != proto::BodyKind::elastic;
+  for (std::size_t b = 0; b < meshes.bodies.size(); ++b) m_any_rigid |= !deforms(static_cast<int>(b));
 }
 
 // Every triangle of body b at positions x, against every box its bounding box meets (and its
@@ -369,8 +369,7 @@ void ImmersedSolid::gather(const Fixed& fixed, const Raw& moving, Faces& p, Scra
   if (m_any_rigid) {
     p.elastic_area.assign(nf, 0.0);
     for (std::size_t e = 0; e < moving.size(); ++e)
-      if (m_meshes.bodies[moving[e].body].kind == proto::BodyKind::elastic)
-        p.elastic_area[p.slot_moving[e]] += moving[e].area();
+      if (deforms(moving[e].body)) p.elastic_area[p.slot_moving[e]] += moving[e].area();
   }
   p.total_area = 0;
   for (std::size_t k = 0; k < nf; ++k) {

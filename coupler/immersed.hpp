@@ -194,8 +194,12 @@ class ImmersedSolid {
   alignas(kLine) Scratch m_scratch_u;
   alignas(kLine) Scratch m_scratch_v;
   bool m_fixed_done = false;  // set after both threads are done
-  // Some body is not elastic: FaceSolid::elastic is sent (protocol version 8), else left empty.
+  // Some body is rigid (kind 1 or 2, or kind 0 with BodyMesh::rigid): FaceSolid::elastic is
+  // sent (protocol version 8), else left empty.
   bool m_any_rigid = false;
+  bool deforms(int b) const {
+    return m_meshes.bodies[b].kind == proto::BodyKind::elastic && m_meshes.bodies[b].rigid == 0;
+  }
   bool m_threads = false;  // the two families on two threads (more than one core)
 };
 

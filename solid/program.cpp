@@ -139,6 +139,7 @@ fsi::proto::BodyMeshes SolidProgram::meshes() const {
     m.kind = g.kind == BodyKind::elastic ? fsi::proto::BodyKind::elastic
              : g.moving                    ? fsi::proto::BodyKind::rigid_moving
                                            : fsi::proto::BodyKind::rigid_fixed;
+    m.rigid = g.kind == BodyKind::elastic ? 0 : 1;
     m.x_ref = g.x_ref;
     for (const auto& t : g.triangles) m.tri.insert(m.tri.end(), t.begin(), t.end());
     for (const auto& e : g.surface) m.edges.insert(m.edges.end(), e.begin(), e.end());

@@ -78,6 +78,7 @@ class Program:
             w.vec(b.x_ref.ravel(), np.float64)
             w.vec(b.tri.ravel(), np.int32)
             w.vec(mesh.surface_edges(b.tri).ravel(), np.int32)
+            w.i32(1)  # rigid: no strain, so the fluid keeps its viscosity in it (version 8)
         w.i32(1)  # can_iterate
         return w.bytes()
 

@@ -33,6 +33,9 @@ PARSER.add_argument("--explicit-diffusion", action="store_true",
 PARSER.add_argument("--after-solve", action="store_true",
                     help='Crank-Nicolson with [fluid] implicit_forcing = "after_solve"')
 ARGS = PARSER.parse_args()
+if ARGS.explicit_diffusion and ARGS.after_solve:
+    PARSER.error("--after-solve chooses Crank-Nicolson's forcing; --explicit-diffusion has no "
+                 "implicit solve: give one of them")
 SHORT = ARGS.short
 EXPLICIT = ARGS.explicit_diffusion
 AFTER_SOLVE = ARGS.after_solve

@@ -26,15 +26,19 @@ TEST_CASE("every message survives a round trip") {
   CHECK(g2.density == 1000.0);
 
   BodyMeshes bm;
-  bm.bodies.push_back({"bar", BodyKind::elastic, {0, 0, 1, 0, 0, 1}, {0, 1, 2}, {0, 1, 1, 2, 2, 0}});
-  bm.bodies.push_back({"cylinder", BodyKind::rigid_fixed, {}, {}, {}});
+  bm.bodies.push_back({"bar", BodyKind::elastic, {0, 0, 1, 0, 0, 1}, {0, 1, 2}, {0, 1, 1, 2, 2, 0}, 0});
+  bm.bodies.push_back({"cylinder", BodyKind::rigid_fixed, {}, {}, {}, 1});
+  bm.bodies.push_back({"disk", BodyKind::elastic, {}, {}, {}, 1});  // a free rigid body
   bm.can_iterate = 1;
   const auto bm2 = round_trip(bm);
   CHECK(bm2.can_iterate == 1);
-  REQUIRE(bm2.bodies.size() == 2);
+  REQUIRE(bm2.bodies.size() == 3);
   CHECK(bm2.bodies[0].name == "bar");
   CHECK(bm2.bodies[0].tri == bm.bodies[0].tri);
+  CHECK(bm2.bodies[0].rigid == 0);
   CHECK(bm2.bodies[1].kind == BodyKind::rigid_fixed);
+  CHECK(bm2.bodies[2].kind == BodyKind::elastic);
+  CHECK(bm2.bodies[2].rigid == 1);
 
   FiberLayout fl;
   fl.fibers.push_back({"f0", 63, 0.002, 1, "wall", 12, 0.25, 0.5, 0.125, 0.1});

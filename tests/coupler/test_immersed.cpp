@@ -404,7 +404,7 @@ TEST_CASE("overlapping bodies: alpha capped at 1, the mean velocity weighted by 
 }
 
 // The elastic bodies' part of α (protocol version 8), where the fluid takes its viscosity out of
-// the bodies: none sent while every body is elastic; with a rigid body (fixed or moving) that
+// the bodies: none sent while every body is elastic; with a rigid body (fixed, prescribed or free) that
 // overlaps an elastic one, min(1, |CV ∩ elastic|/|CV|) on every face, the elastic body's exact
 // outline clipped as reference, on faces of either body alone and of both.
 TEST_CASE("the elastic part of alpha: empty when all bodies are elastic, else theirs alone") {
@@ -428,8 +428,12 @@ TEST_CASE("the elastic part of alpha: empty when all bodies are elastic, else th
     CHECK(u.elastic.empty());
     CHECK(v.elastic.empty());
   }
-  for (const auto kind : {proto::BodyKind::rigid_fixed, proto::BodyKind::rigid_moving}) {
+  // Fixed, prescribed, and free (kind 0, rigid = 1: solid_rigid's bodies).
+  for (const auto& [kind, rigid_flag] :
+       {std::pair{proto::BodyKind::rigid_fixed, 0}, std::pair{proto::BodyKind::rigid_moving, 0},
+        std::pair{proto::BodyKind::elastic, 1}}) {
     m.bodies[1].kind = kind;
+    m.bodies[1].rigid = rigid_flag;
     ImmersedSolid is(g, m);
     proto::FaceSolid u, v;
     is.update(s, u, v);

@@ -1,13 +1,15 @@
 #!/usr/bin/python3
 """[fluid] body_viscosity = "none" takes the fluid's viscosity out of elastic bodies only.
 
-  rigid_body_viscosity.py --cwd DIR --bin BIN --elastic SCENE -- MPIEXEC...
+  rigid_body_viscosity.py --cwd DIR --bin BIN --elastic SCENE --free DISK -- MPIEXEC...
 
 1. A fixed rigid block under Couette flow (runs/sub-cell-wall's set-up at lambda = 2, its top in
    the middle of a cell, 300 steps): run with "none" and with "kelvin-voigt", every CSV and .h5
    dataset must be the same bit for bit (a rigid body keeps the fluid's viscosity; when the
    correction also took the block's cut faces, its wall moved a third of a cell into the block).
-2. The control: SCENE (an elastic layer) cut to 0.05, with "none" and with "kelvin-voigt", must
+2. The same for DISK (a free rigid body moved by solid-rigid, a body of kind 0 that says it is
+   rigid) cut to 0.05.
+3. The control: SCENE (an elastic layer) cut to 0.05, with "none" and with "kelvin-voigt", must
    differ, so that the correction is still applied where it belongs.
 Exits 1 naming what went wrong.
 """
@@ -49,13 +51,13 @@ rectangle = {{ origin = [0.0, 0.0], size = [0.25, {4.5 / N!r}], cells = [2, 4] }
 """
 
 
-def run(mpiexec, bin_dir, text, cwd, name):
+def run(mpiexec, bin_dir, text, cwd, name, solid="solid"):
     scene = os.path.join(cwd, name + ".toml")
     with open(scene, "w") as f:
         f.write(text)
     out = os.path.join(cwd, name)
     cmd = list(mpiexec)
-    for k, p in enumerate(["fluid", "solid", "coupler"]):
+    for k, p in enumerate(["fluid", solid, "coupler"]):
         if k:
             cmd.append(":")
         cmd += ["-n", "1", os.path.join(bin_dir, p), scene, "--out-dir", out, "--overwrite"]
@@ -66,11 +68,23 @@ def run(mpiexec, bin_dir, text, cwd, name):
     return out
 
 
+def short(scene):
+    """The scene's text cut to t = 0.05, its relative mesh paths made absolute."""
+    with open(scene) as f:
+        text = f.read()
+    text = re.sub(r"\nt_end = [0-9.e+-]+", "\nt_end = 0.05", text)
+    text = re.sub(r"\ninterval = [0-9.e+-]+", "\ninterval = 0.025", text)
+    here = os.path.dirname(os.path.abspath(scene))
+    return re.sub(r'\nmesh = "([^"/][^"]*)"',
+                  lambda m: f'\nmesh = "{os.path.normpath(os.path.join(here, m.group(1)))}"', text)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--cwd", required=True)
     ap.add_argument("--bin", required=True)
     ap.add_argument("--elastic", required=True)
+    ap.add_argument("--free", required=True)
     ap.add_argument("mpiexec", nargs="+")
     a = ap.parse_args()
     os.makedirs(a.cwd, exist_ok=True)
@@ -83,10 +97,21 @@ def main():
                  f"\"kelvin-voigt\": {diff}; a rigid body must keep the fluid's viscosity")
     print(f"rigid_body_viscosity: rigid block, {compared} files and datasets the same")
 
-    with open(a.elastic) as f:
-        text = f.read()
-    text = re.sub(r"\nt_end = [0-9.e+-]+", "\nt_end = 0.05", text)
-    text = re.sub(r"\ninterval = [0-9.e+-]+", "\ninterval = 0.025", text)
+    # The free disk: its scene without the key (the default "none") and with "kelvin-voigt".
+    text = short(a.free)
+    if "body_viscosity" in text or 'diffusion = "implicit"' not in text:
+        sys.exit(f"rigid_body_viscosity: {a.free} should name Crank-Nicolson and no body_viscosity")
+    outs = [run(a.mpiexec, a.bin,
+                text.replace('diffusion = "implicit"', f'diffusion = "implicit"\n{extra}'),
+                a.cwd, f"free-{v}", solid="solid-rigid")
+            for v, extra in (("none", ""), ("kelvin-voigt", 'body_viscosity = "kelvin-voigt"'))]
+    diff, compared = compare_dirs(*outs)
+    if diff:
+        sys.exit(f"rigid_body_viscosity: a free rigid disk with body_viscosity = \"none\" and "
+                 f"\"kelvin-voigt\": {diff}; a rigid body must keep the fluid's viscosity")
+    print(f"rigid_body_viscosity: free rigid disk, {compared} files and datasets the same")
+
+    text = short(a.elastic)
     if 'body_viscosity = "none"' not in text:
         sys.exit(f"rigid_body_viscosity: {a.elastic} does not name body_viscosity = \"none\"")
     outs = [run(a.mpiexec, a.bin, text.replace('body_viscosity = "none"', f'body_viscosity = "{v}"'),
