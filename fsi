@@ -32,7 +32,8 @@ usage: ./fsi COMMAND [ARGS]
                               bounds-checked field access on); unit and integration tests
   test --sanitize [ARGS]      the same in an address + undefined-behaviour sanitizer build
                               (build-sanitize/); unit and integration tests
-  validate [CASE...]          run the validation cases in runs/ (all when none is named)
+  validate [CASE...] [-- OPT...]  run the validation cases in runs/ (all when none is named);
+                              OPT... go to each case's validate.py (e.g. --short)
   bench [WHAT]                run a benchmark (fluid, solid, fiber, coupler, coupled, protocol,
                               vocal-folds, fluid-ranks);
                               without WHAT, list them
@@ -269,7 +270,12 @@ test_suite() {
 
 validate() {
   build
-  local cases=("$@")
+  # CASE... then, from the first argument that starts with '-' (a lone '--' is dropped), the
+  # options every named case's validate.py gets.
+  local cases=() opts=()
+  while [ $# -gt 0 ] && [ "${1#-}" = "$1" ]; do cases+=("$1"); shift; done
+  [ "${1:-}" = "--" ] && shift
+  opts=("$@")
   if [ ${#cases[@]} -eq 0 ]; then
     for d in "$ROOT"/runs/*/; do [ -x "$d/validate.py" ] && cases+=("$(basename "$d")"); done
   fi
@@ -280,7 +286,7 @@ validate() {
     [ -x "$script" ] || die "no validation case '$c' (runs/$c/validate.py); cases: $(cd "$ROOT/runs" && ls -d */ | tr -d /)"
     say "validating $c"
     mkdir -p "$ROOT/out/$c"
-    if FSI_ROOT=$ROOT FSI_BIN=$BIN FSI_OUT=$ROOT/out/$c "$script"; then
+    if FSI_ROOT=$ROOT FSI_BIN=$BIN FSI_OUT=$ROOT/out/$c "$script" "${opts[@]}"; then
       say "$c: done (out/$c/summary.json)"
     else
       failed+=("$c")

@@ -6,6 +6,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <map>
 #include <sstream>
 #include <toml.hpp>
@@ -119,6 +120,7 @@ void write_checkpoint(const Runtime& rt, long step, const std::function<void(H5F
     h5.set_attribute("/", "step", static_cast<std::int64_t>(step));
     h5.set_attribute("/", "time", step_time(rt.settings(), step));
     h5.set_attribute("/", "scene", rt.scene().effective_toml());
+    h5.set_attribute("/", "protocol_version", static_cast<std::int64_t>(proto::kVersion));
     fill(h5);
     h5.flush();
   }
@@ -215,6 +217,19 @@ std::string changed_physics_key(const std::string& before, const std::string& no
 H5File open_restart(const Runtime& rt) {
   const long step = *rt.restart_step();
   H5File h5(checkpoint_file(rt.out_dir(), step, rt.role()), H5File::Mode::read_only);
+  // A build of another protocol version may compute other physics from the same scene (version
+  // 8: rigid bodies keep the fluid's viscosity under fluid.body_viscosity = "none").
+  const long version = h5.has_attribute("/", "protocol_version")
+                           ? std::lround(h5.attribute_number("/", "protocol_version"))
+                           : 0;
+  if (version != proto::kVersion)
+    throw InputError(fmt::format(
+        "the checkpoint of step {} in {} was written by a build of protocol version {}, this "
+        "build speaks {}: its coupling may differ (version 8: rigid bodies keep the fluid's "
+        "viscosity under fluid.body_viscosity = \"none\"); run the scene from the start, or "
+        "resume with the build that wrote it (in {})",
+        step, rt.out_dir().string(), version ? std::to_string(version) : "7 or older",
+        proto::kVersion, rt.scene().file().string()));
   const std::string key = changed_physics_key(h5.attribute_string("/", "scene"), rt.scene().effective_toml());
   if (!key.empty()) {
     // A key recorded since its default changed: say what the checkpoint's run used.

@@ -56,6 +56,7 @@ nlohmann::json base_summary(const Runtime& rt, long steps) {
   nlohmann::json j;
   j["scene"] = rt.settings().name;
   j["scene_file"] = rt.scene().file().string();
+  j["protocol_version"] = proto::kVersion;
   j["steps"] = steps;
   j["time"] = step_time(rt.settings(), steps);
   j["dt"] = rt.settings().dt;

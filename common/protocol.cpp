@@ -132,6 +132,11 @@ void FluidInput::pack(Writer& w) const {
 void FluidInput::unpack(Reader& r) {
   get(r, solid_u), get(r, solid_v), get(r, force_u), get(r, force_v);
   r.get(sample_u), r.get(sample_v), r.get(sample_p);
+  // The elastic part is sent for every face of both families or for none.
+  const bool some = !solid_u.elastic.empty() || !solid_v.elastic.empty();
+  for (const FaceSolid* f : {&solid_u, &solid_v})
+    if (some && f->elastic.size() != f->index.size())
+      fail("protocol error: the elastic part of alpha sent for some faces only");
 }
 
 void FluidOutput::pack(Writer& w) const {

@@ -217,9 +217,10 @@ struct StepBegin {  // coupler -> each solver, every step
 
 // Solid on faces: for each listed face, the solid volume fraction alpha in [0, 1] of its
 // control volume and the mean solid velocity component over the solid part of it. Since
-// version 8, elastic: the part of alpha that belongs to elastic bodies (kind 0, not rigid), in the same
-// order, which is where the fluid takes its viscosity out of the bodies (fluid.body_viscosity
-// = "none"); empty when every body of the scene is elastic (then it is alpha).
+// version 8, elastic: the part of alpha that belongs to elastic bodies (kind 0, not rigid), in
+// the same order, which is where the fluid takes its viscosity out of the bodies
+// (fluid.body_viscosity = "none"); empty in both families when every body of the scene is
+// elastic (then it is alpha), else one value per face in both.
 struct FaceSolid {
   std::vector<std::int32_t> index;
   std::vector<double> alpha;

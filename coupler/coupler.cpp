@@ -313,6 +313,7 @@ void Coupler::finish(long steps, long first) {
   nlohmann::json j;
   j["scene"] = s.name;
   j["scene_file"] = m_rt.scene().file().string();
+  j["protocol_version"] = proto::kVersion;
   j["steps"] = steps;
   j["time"] = fsi::step_time(s, steps);
   j["dt"] = s.dt;

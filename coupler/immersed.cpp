@@ -137,7 +137,8 @@ ImmersedSolid::ImmersedSolid(const proto::GridInfo& grid, const proto::BodyMeshe
   m_scratch_u.slot.assign(static_cast<std::size_t>(m_uf.faces.ni * m_uf.faces.nj), -1);
   m_scratch_v.slot.assign(static_cast<std::size_t>(m_vf.faces.ni * m_vf.faces.nj), -1);
   m_threads = std::thread::hardware_concurrency() > 1;
-  for (std::size_t b = 0; b < meshes.bodies.size(); ++b) m_any_rigid |= !deforms(static_cast<int>(b));
+  for (std::size_t b = 0; b < meshes.bodies.size(); ++b)
+    m_any_rigid |= !deforms(static_cast<int>(b));
 }
 
 // Every triangle of body b at positions x, against every box its bounding box meets (and its

@@ -32,27 +32,34 @@ namespace fluid {
 // halo brings the rows across the periodic boundary (the first and last ranks are neighbours),
 // so there the rows are read where they are stored instead of wrapped.
 //
-// Whether any rank has faces decides, the same on every rank (the halos below are collective);
-// with explicit diffusion a step whose footprint has faces after a step without any did not
-// keep uⁿ and keeps the viscosity inside the bodies that once (a body entering the grid; bodies
-// there from the start have faces at the first step; Crank-Nicolson always keeps uⁿ).
+// Whether any rank has faces of an elastic body decides, the same on every rank (the halos
+// below are collective); with explicit diffusion a step whose footprint has such faces after a
+// step without any did not keep uⁿ and keeps the viscosity inside the bodies that once (a body
+// entering the grid; bodies there from the start have faces at the first step; Crank-Nicolson
+// always keeps uⁿ).
 //
 // Only elastic bodies lose the viscosity: the coupler's α of the elastic bodies alone (CouplingIn
 // solid_*_elastic; α itself when every body is elastic). A rigid body has no strain inside, so
 // the correction would touch only its surface, where it moves the wall the flow sees up to a
 // third of a cell further into the body (runs/sub-cell-wall); a rigid body keeps the fluid's
-// viscosity, which is the same rigid body.
+// viscosity, which is the same rigid body. In the minima a rigid body's face counts as fluid, so
+// where an elastic body meets a rigid one (a bar clamped to a cylinder) the viscous flux between
+// them stays: a joint of the fluid's viscosity, nothing against a tissue's elastic stress.
 void Solver::remove_body_viscosity(double dt, const CouplingIn& in) {
   if (!m_cfg.bodies_inviscid) return;
   const std::span<const std::int32_t> idx[2] = {in.solid_u_index, in.solid_v_index};
-  const bool mixed = !in.solid_u_elastic.empty() || !in.solid_v_elastic.empty();
-  const std::span<const double> alpha[2] = {mixed ? in.solid_u_elastic : in.solid_u_alpha,
-                                            mixed ? in.solid_v_elastic : in.solid_v_alpha};
+  // Per family (the protocol sends the elastic part for both or for neither).
+  const bool mixed[2] = {!in.solid_u_elastic.empty(), !in.solid_v_elastic.empty()};
+  const std::span<const double> alpha[2] = {mixed[0] ? in.solid_u_elastic : in.solid_u_alpha,
+                                            mixed[1] ? in.solid_v_elastic : in.solid_v_alpha};
+  for (int c = 0; c < 2; ++c)
+    if (alpha[c].size() != idx[c].size())
+      fsi::fail("fluid: {} volume fractions for {} solid faces", alpha[c].size(), idx[c].size());
   // Whether this rank has faces of an elastic body.
   bool here = false;
   for (int c = 0; c < 2; ++c)
-    here |= mixed ? std::any_of(alpha[c].begin(), alpha[c].end(), [](double a) { return a > 0; })
-                  : !idx[c].empty();
+    here |= mixed[c] ? std::any_of(alpha[c].begin(), alpha[c].end(), [](double a) { return a > 0; })
+                     : !idx[c].empty();
   m_body_faces = m_dec.serial() ? here : m_dec.sum(here ? 1.0 : 0.0) > 0;
   if (!m_body_faces || !m_un_kept) return;
   const int nx = m_grid.nx(), ny = m_grid.ny();

@@ -155,8 +155,9 @@ Solver::Solver(const Config& c, double dt, MPI_Comm comm)
     m_slab_poisson = std::make_unique<SlabSolver>(pt, ps, 0.0, m_t_axis, ny, 0, comm);
     m_slab_poisson->set_mean_weights(w);
   }
-  // u^n: body_viscosity = "none" has begin_step copy it once the footprint has faces, and the
-  // α fields are made at the first faces (body_viscosity.cpp), so a run without bodies has none.
+  // u^n: body_viscosity = "none" has begin_step copy it once the footprint has faces of an
+  // elastic body, and the α fields are made at the first such faces (body_viscosity.cpp), so a
+  // run without elastic bodies has none.
   if (c.implicit) {
     m_un = Field(nx + 1, ny, lo, hi);
     m_vn = Field(nx, ny + 1, lo, vhi);

@@ -81,13 +81,26 @@ def same_defaults(folder):
     """Whether a finished run ran with today's defaults of the keys whose default changed: its
     effective scene records them (fluid.body_viscosity since the bodies became elastic by
     default; before, an unnamed key meant "kelvin-voigt"; fluid.implicit_forcing with
-    Crank-Nicolson since "increment" became its default; before, "after_solve")."""
+    Crank-Nicolson since "increment" became its default; before, "after_solve"); and, with
+    rigid bodies under body_viscosity = "none", a build of protocol version 8 or later
+    (summary.json; since version 8 "none" leaves rigid bodies their viscosity; runs before it
+    record no version; a run without a summary yet is not judged on it)."""
     path = os.path.join(folder, "scene.effective.toml")
     if not os.path.exists(path):
         return True
     text = open(path).read()
     if "[fluid]" not in text:
         return True
+    rigid = re.search(r'^(kind\s*=\s*"rigid"|program\s*=\s*"solid-rigid")', text, re.M)
+    if rigid and re.search(r'^body_viscosity\s*=\s*"none"', text, re.M):
+        try:
+            with open(os.path.join(folder, "summary.json")) as f:
+                if json.load(f).get("protocol_version", 0) < 8:
+                    return False
+        except OSError:
+            pass
+        except ValueError:
+            return False
     crank_nicolson = re.search(r'^diffusion\s*=\s*"implicit"', text, re.M) is not None
     return "body_viscosity" in text and (not crank_nicolson or "implicit_forcing" in text)
 

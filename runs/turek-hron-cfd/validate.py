@@ -18,8 +18,9 @@ set by TAU instead of dt; fluid/forcing.cpp); runs and the --bands-xy JSON named
 always written, so that --reuse never takes a run of the direct solve for one of the factored);
 runs with the direct solve are named *-direct.
 `--body-viscosity none|kelvin-voigt`: fluid.body_viscosity written into the scenes (none, the
-fluid's default: the mixture stress on the cut faces, fluid/README.md; kelvin-voigt: the model
-of the README's tables), every output under OUT/body-viscosity-X.
+fluid's default; kelvin-voigt: the model of the README's first tables), every output under
+OUT/body-viscosity-X. Since protocol version 8 "none" leaves the rigid cylinder its viscosity,
+so both give the same forces here; the README's "none" table was measured before.
 `--implicit-forcing increment|after_solve`: fluid.implicit_forcing written into the scenes
 (increment, the fluid's default; after_solve: the forcing of the tables measured before it), every
 output under OUT/implicit-forcing-X; `--forcing-time` writes after_solve (it blends that forcing).

@@ -26,7 +26,8 @@ TEST_CASE("every message survives a round trip") {
   CHECK(g2.density == 1000.0);
 
   BodyMeshes bm;
-  bm.bodies.push_back({"bar", BodyKind::elastic, {0, 0, 1, 0, 0, 1}, {0, 1, 2}, {0, 1, 1, 2, 2, 0}, 0});
+  bm.bodies.push_back(
+      {"bar", BodyKind::elastic, {0, 0, 1, 0, 0, 1}, {0, 1, 2}, {0, 1, 1, 2, 2, 0}, 0});
   bm.bodies.push_back({"cylinder", BodyKind::rigid_fixed, {}, {}, {}, 1});
   bm.bodies.push_back({"disk", BodyKind::elastic, {}, {}, {}, 1});  // a free rigid body
   bm.can_iterate = 1;
@@ -59,8 +60,9 @@ TEST_CASE("every message survives a round trip") {
   CHECK(sb2.action == Action::stop);
 
   FluidInput fi;
+  // A rigid body beside an elastic one: the elastic part of alpha on every face of both.
   fi.solid_u = {{1, 5, 9}, {0.5, 1.0, 0.25}, {0.1, 0.2, 0.3}, {0.5, 0.0, 0.125}};
-  fi.solid_v = {{2}, {0.75}, {-0.1}, {}};  // every body elastic: no separate fraction
+  fi.solid_v = {{2}, {0.75}, {-0.1}, {0.0}};
   fi.force_v = {{4}, {-2.5}};
   fi.sample_u = {3, 4};
   fi.sample_p = {7};
@@ -69,7 +71,11 @@ TEST_CASE("every message survives a round trip") {
   CHECK(fi2.solid_u.velocity == fi.solid_u.velocity);
   CHECK(fi2.solid_u.elastic == fi.solid_u.elastic);
   CHECK(fi2.solid_v.index == fi.solid_v.index);
-  CHECK(fi2.solid_v.elastic.empty());
+  CHECK(fi2.solid_v.elastic == fi.solid_v.elastic);
+  fi.solid_u.elastic.clear(), fi.solid_v.elastic.clear();  // every body elastic: none sent
+  const auto fi3 = round_trip(fi);
+  CHECK(fi3.solid_u.elastic.empty());
+  CHECK(fi3.solid_v.elastic.empty());
   CHECK(fi2.force_v.force == fi.force_v.force);
   CHECK(fi2.sample_u == fi.sample_u);
   CHECK(fi2.sample_p == fi.sample_p);
@@ -113,6 +119,17 @@ TEST_CASE("damaged or mismatched messages are refused") {
     FluidInput back;
     CHECK_THROWS_WITH(unpack_message(pack_message(fi, 1), back),
                       Catch::Contains("face solid arrays of different lengths"));
+    fi.solid_u.elastic = {0.5, 0.0};
+    fi.solid_v = {{3}, {0.25}, {0.0}, {}};  // the v faces without theirs
+    CHECK_THROWS_WITH(unpack_message(pack_message(fi, 1), back),
+                      Catch::Contains("elastic part of alpha sent for some faces only"));
+  }
+  SECTION("a body neither rigid nor not") {
+    BodyMeshes bm;
+    bm.bodies.push_back({"disk", BodyKind::elastic, {}, {}, {}, 2});
+    BodyMeshes back;
+    CHECK_THROWS_WITH(unpack_message(pack_message(bm, 0), back),
+                      Catch::Contains("body 'disk' has rigid = 2, not 0 or 1"));
   }
   SECTION("another protocol version") {
     Header h;

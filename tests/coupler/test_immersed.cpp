@@ -404,8 +404,8 @@ TEST_CASE("overlapping bodies: alpha capped at 1, the mean velocity weighted by 
 }
 
 // The elastic bodies' part of α (protocol version 8), where the fluid takes its viscosity out of
-// the bodies: none sent while every body is elastic; with a rigid body (fixed, prescribed or free) that
-// overlaps an elastic one, min(1, |CV ∩ elastic|/|CV|) on every face, the elastic body's exact
+// the bodies: none sent while every body is elastic; with a rigid body (fixed, prescribed or
+// free) that overlaps an elastic one, min(1, |CV ∩ elastic|/|CV|) on every face, the elastic body's exact
 // outline clipped as reference, on faces of either body alone and of both.
 TEST_CASE("the elastic part of alpha: empty when all bodies are elastic, else theirs alone") {
   const auto g = grid(24, 20, 1.2, 1.0, false, false);

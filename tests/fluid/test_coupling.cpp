@@ -401,6 +401,53 @@ TEST_CASE("body_viscosity = none: no viscous force inside a body, the traction k
   }
 }
 
+// The elastic part of α (protocol version 8): "none" with it equal to α is "none" with none sent
+// (every body elastic), and with it zero (every body rigid) is "kelvin-voigt", bit for bit; the
+// same layer over the shear as above, both diffusions.
+TEST_CASE("body_viscosity = none acts on the elastic part of alpha only", "[fluid][coupling]") {
+  for (Diffusion d : {explicit_ab2, crank_nicolson_after_solve}) {
+    CAPTURE(d);
+    const double dt = 1e-3;
+    enum Variant { all_elastic, elastic_is_alpha, all_rigid, kelvin_voigt };
+    std::vector<double> u[4], v[4], fu[4], fv[4];
+    for (int k = 0; k < 4; ++k) {
+      Config c = with(box(BcType::periodic), d);
+      c.bodies_inviscid = k != kelvin_voigt;
+      Solver s(c, dt);
+      const Grid& g = s.grid();
+      for (int j = -1; j <= g.ny(); ++j)
+        for (int i = -1; i <= g.nx(); ++i) {
+          const double y = (j + 0.5) * g.y().h();
+          s.u()(i, j) = y * y;
+        }
+      std::vector<std::int32_t> iu, iv;
+      std::vector<double> au, uu, av, vv;
+      for (int j = 2; j < 6; ++j)
+        for (int i = 0; i < g.nx(); ++i)
+          iu.push_back(i + g.nu() * j), au.push_back(j == 2 ? 0.6 : 1.0), uu.push_back(s.u()(i, j));
+      for (int j = 2; j <= 6; ++j)
+        for (int i = 0; i < g.nx(); ++i)
+          iv.push_back(i + g.nx() * j), av.push_back(j == 2 || j == 6 ? 0.5 : 1.0), vv.push_back(0);
+      CouplingIn in = solid_input(iu, au, uu, iv, av, vv);
+      const std::vector<double> zu(au.size(), 0.0), zv(av.size(), 0.0);
+      if (k == elastic_is_alpha) in.solid_u_elastic = au, in.solid_v_elastic = av;
+      if (k == all_rigid) in.solid_u_elastic = zu, in.solid_v_elastic = zv;
+      CouplingOut out;
+      for (int n = 0; n < 3; ++n) s.step(dt, in, out);
+      u[k] = s.u().a, v[k] = s.v().a, fu[k] = out.solid_u_force, fv[k] = out.solid_v_force;
+    }
+    CHECK(u[elastic_is_alpha] == u[all_elastic]);
+    CHECK(v[elastic_is_alpha] == v[all_elastic]);
+    CHECK(fu[elastic_is_alpha] == fu[all_elastic]);
+    CHECK(fv[elastic_is_alpha] == fv[all_elastic]);
+    CHECK(u[all_rigid] == u[kelvin_voigt]);
+    CHECK(v[all_rigid] == v[kelvin_voigt]);
+    CHECK(fu[all_rigid] == fu[kelvin_voigt]);
+    CHECK(fv[all_rigid] == fv[kelvin_voigt]);
+    CHECK(fu[all_elastic] != fu[kelvin_voigt]);  // the correction acts at all
+  }
+}
+
 // A rigid rotation has no strain (D = 0): "none" must leave a rotating body's forcing as it is,
 // at its edges too (the Laplacian form (1 - phi) mu grad u would not: it would take half the
 // viscous torque on the body's surface, the part the fluid inside carries).

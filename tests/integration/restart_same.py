@@ -13,7 +13,9 @@ through; the stopped run is
           then restarted to T.
 Before the restart, a newer checkpoint folder that not every program completed is planted (a
 crash while writing): the restart must pass it by. With --change 'OLD=>NEW' a restart of the
-scene with that text replaced must first be refused with an error naming --key.
+scene with that text replaced must first be refused with an error naming --key. With
+--older-version the checkpoint's files are first marked as written by protocol version 7: the
+restart must be refused naming it (then the marks are put back).
 --fluid-ranks runs the stopped run's fluid on P ranks, --restart-ranks the restart's on Q (the
 run straight through stays on one): a checkpoint holds the whole grid whatever the rank count.
 Compared: every CSV file byte for byte and every numeric HDF5 dataset (compare_outputs.py), and
@@ -93,6 +95,8 @@ def main():
     ap.add_argument("--extra", default="", help="TOML text appended to the scene (\\n: a new line)")
     ap.add_argument("--change", help="'OLD=>NEW': a scene text change the restart must refuse")
     ap.add_argument("--key", help="the key the refusal must name")
+    ap.add_argument("--older-version", action="store_true",
+                    help="a checkpoint of protocol version 7 must be refused")
     ap.add_argument("--fluid-ranks", type=int, default=1, help="the stopped run's fluid ranks")
     ap.add_argument("--restart-ranks", type=int, help="the restart's fluid ranks (default: --fluid-ranks)")
     a = ap.parse_args()
@@ -141,6 +145,24 @@ def main():
                 sys.exit(f"restart_same: the restart with {a.change} was not refused naming {a.key} "
                          f"(exit {r.returncode}):\n{r.stderr[-2000:]}")
             print(f"restart_same: a restart with {a.change} is refused naming {a.key}")
+        if a.older_version:
+            import h5py
+            files = [p for p in glob.glob(os.path.join(stopped, "checkpoint", "step_*", "*.h5"))
+                     if "99999999" not in p]
+            kept = {}
+            for p in files:
+                with h5py.File(p, "r+") as h5:
+                    kept[p] = h5.attrs["protocol_version"]
+                    h5.attrs["protocol_version"] = 7
+            r = subprocess.run(command(a.bin, full, ["--restart", stopped]), capture_output=True,
+                               text=True, timeout=120)
+            for p, v in kept.items():
+                with h5py.File(p, "r+") as h5:
+                    h5.attrs["protocol_version"] = v
+            if r.returncode == 0 or "written by a build of protocol version 7" not in r.stderr:
+                sys.exit("restart_same: a checkpoint of protocol version 7 was not refused "
+                         f"(exit {r.returncode}):\n{r.stderr[-2000:]}")
+            print("restart_same: a checkpoint of protocol version 7 is refused")
         log = run(a.bin, full, ["--restart", stopped], "restart", a.restart_ranks or a.fluid_ranks)
         print(log.strip().splitlines()[-1] if log.strip() else "")
     finally:
