@@ -106,7 +106,9 @@ for where, height in HEIGHTS.items():
         results[f"order_{where}"] = orders
         metrics[f"order_{where}"] = metric(orders[-1], 1.0, max(0.0, 1.0 - orders[-1]),
                                            1.0 - TOL_ORDER)
-        axes[0][1].loglog([1.0 / n for n in GRIDS], errs, "o-", label=f"interface {where} grid")
+        label = {"on": "interface on a grid line", "off": "interface at 0.51",
+                 "off_cell": "interface 0.64 of a cell above a line"}[where]
+        axes[0][1].loglog([1.0 / n for n in GRIDS], errs, "o-", label=label)
 ax = axes[0][0]
 ax.set_xlabel("u")
 ax.set_ylabel("y")
