@@ -50,22 +50,6 @@ bool may_change(const std::string& path) {
          path == "fluid.ranks";
 }
 
-// Keys whose default changed, so that the effective scene records them from then on: a
-// checkpoint written before holds no such key, and ran as the value given here. A resumed run
-// that sets that value explicitly continues the same physics.
-const std::map<std::string, std::string>& legacy_values() {
-  static const std::map<std::string, std::string> kLegacy = {
-      {"fluid.body_viscosity", "kelvin-voigt"},  // the default until the bodies became elastic
-      {"fluid.implicit_forcing", "after_solve"},  // Crank-Nicolson's default until "increment"
-  };
-  return kLegacy;
-}
-
-bool legacy_value(const std::string& path, const Toml& now) {
-  const auto it = legacy_values().find(path);
-  return it != legacy_values().end() && now.is_string() && now.as_string().str == it->second;
-}
-
 std::string first_difference(const Toml& a, const Toml& b, const std::string& path) {
   if (!path.empty() && may_change(path)) return {};
   if (a.is_table() && b.is_table()) {
@@ -79,7 +63,7 @@ std::string first_difference(const Toml& a, const Toml& b, const std::string& pa
     }
     for (const auto& [k, v] : b.as_table()) {
       const std::string p = path.empty() ? k : path + "." + k;
-      if (!a.as_table().count(k) && !may_change(p) && !legacy_value(p, v)) return p;
+      if (!a.as_table().count(k) && !may_change(p)) return p;
     }
     return {};
   }
@@ -214,9 +198,11 @@ std::string changed_physics_key(const std::string& before, const std::string& no
   return first_difference(parse_toml(before, "checkpoint"), parse_toml(now, "scene"), "");
 }
 
-H5File open_restart(const Runtime& rt) {
-  const long step = *rt.restart_step();
-  H5File h5(checkpoint_file(rt.out_dir(), step, rt.role()), H5File::Mode::read_only);
+// Checked by every program on its own file before anything of the run is opened (runtime.cpp),
+// so that a refused restart leaves the output as it was.
+void check_checkpoint_version(const std::filesystem::path& out_dir, long step, Role role,
+                              const std::filesystem::path& scene_file) {
+  const H5File h5(checkpoint_file(out_dir, step, role), H5File::Mode::read_only);
   // A build of another protocol version may compute other physics from the same scene (version
   // 8: rigid bodies keep the fluid's viscosity under fluid.body_viscosity = "none").
   const long version = h5.has_attribute("/", "protocol_version")
@@ -224,25 +210,24 @@ H5File open_restart(const Runtime& rt) {
                            : 0;
   if (version != proto::kVersion)
     throw InputError(fmt::format(
-        "the checkpoint of step {} in {} was written by a build of protocol version {}, this "
-        "build speaks {}: its coupling may differ (version 8: rigid bodies keep the fluid's "
+        "--restart {}: the checkpoint of step {} was written by a build of protocol version {}, "
+        "this build speaks {}: its coupling may differ (version 8: rigid bodies keep the fluid's "
         "viscosity under fluid.body_viscosity = \"none\"); run the scene from the start, or "
-        "resume with the build that wrote it (in {})",
-        step, rt.out_dir().string(), version ? std::to_string(version) : "7 or older",
-        proto::kVersion, rt.scene().file().string()));
+        "resume with the build that wrote the checkpoint (scene {})",
+        out_dir.string(), step,
+        version ? std::to_string(version) : "none recorded (a build before this check)",
+        proto::kVersion, scene_file.string()));
+}
+
+H5File open_restart(const Runtime& rt) {
+  const long step = *rt.restart_step();
+  H5File h5(checkpoint_file(rt.out_dir(), step, rt.role()), H5File::Mode::read_only);
   const std::string key = changed_physics_key(h5.attribute_string("/", "scene"), rt.scene().effective_toml());
-  if (!key.empty()) {
-    // A key recorded since its default changed: say what the checkpoint's run used.
-    std::string hint;
-    if (const auto it = legacy_values().find(key); it != legacy_values().end())
-      hint = fmt::format("; a checkpoint written before {} was recorded ran with {} = \"{}\": "
-                         "give that in the scene to resume it",
-                         key, key.substr(key.rfind('.') + 1), it->second);
+  if (!key.empty())
     throw InputError(fmt::format(
         "{} differs from the run being resumed (checkpoint of step {} in {}): a restart may change "
-        "time.t_end and [output] only{} (in {})",
-        key, step, rt.out_dir().string(), hint, rt.scene().file().string()));
-  }
+        "time.t_end and [output] only (in {})",
+        key, step, rt.out_dir().string(), rt.scene().file().string()));
   return h5;
 }
 

@@ -32,6 +32,11 @@ void write_checkpoint(const Runtime& rt, long step, const std::function<void(H5F
 // The newest step of out_dir/checkpoint whose folder holds a file of every role in `roles`.
 std::optional<long> newest_checkpoint(const std::filesystem::path& out_dir, const RoleSet& roles);
 
+// That `role`'s file of step `step` was written by a build of this protocol version (the
+// attribute protocol_version, since version 8); an InputError naming both otherwise.
+void check_checkpoint_version(const std::filesystem::path& out_dir, long step, Role role,
+                              const std::filesystem::path& scene_file);
+
 // A restarted program's checkpoint file, opened for reading, after checking that the scene's
 // physics did not change: every key of the effective scene but time.t_end, [output],
 // scene.description and [test] must be as it was (an InputError names the first that changed).

@@ -533,6 +533,7 @@ int run_program(Role role, int argc, char** argv, const std::function<void(Runti
             "--restart {}: no complete checkpoint in {} (a checkpoint is written every "
             "output.checkpoint_interval and when a run is asked to stop)",
             opts.restart->string(), (*opts.restart / "checkpoint").string()));
+      check_checkpoint_version(*opts.restart, *rt.m_restart_step, role, opts.scene);
     }
 
     // Handshake: who is here, which protocol, which scene.

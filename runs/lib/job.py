@@ -91,7 +91,8 @@ def same_defaults(folder):
     text = open(path).read()
     if "[fluid]" not in text:
         return True
-    rigid = re.search(r'^(kind\s*=\s*"rigid"|program\s*=\s*"solid-rigid")', text, re.M)
+    # (a key at a line's start, or inside an inline table)
+    rigid = re.search(r'(^|[{,])\s*(kind\s*=\s*"rigid"|program\s*=\s*"solid-rigid")', text, re.M)
     if rigid and re.search(r'^body_viscosity\s*=\s*"none"', text, re.M):
         try:
             with open(os.path.join(folder, "summary.json")) as f:
@@ -99,7 +100,7 @@ def same_defaults(folder):
                     return False
         except OSError:
             pass
-        except ValueError:
+        except (ValueError, AttributeError):
             return False
     crank_nicolson = re.search(r'^diffusion\s*=\s*"implicit"', text, re.M) is not None
     return "body_viscosity" in text and (not crank_nicolson or "implicit_forcing" in text)

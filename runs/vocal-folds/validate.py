@@ -396,10 +396,10 @@ def run_state(name, text):
     scene_file, folder = os.path.join(OUT, name + ".toml"), os.path.join(OUT, name)
     if not (os.path.isdir(folder) and os.path.exists(scene_file) and open(scene_file).read() == text):
         return "missing"
-    if not job.same_defaults(folder):  # the same text ran under an earlier default (job.py)
-        return "missing"
     if locked(folder):
         return "running"
+    if not job.same_defaults(folder):  # the same text ran under an earlier default (job.py)
+        return "missing"
     if os.path.exists(os.path.join(folder, "summary.json")):
         return "finished"
     err, ended = log_error(name)

@@ -44,26 +44,20 @@ TEST_CASE("a restart may change t_end, [output] and the description, nothing els
         "fluid.density");
 }
 
-TEST_CASE("a key recorded since its default changed: absent counts as its old value", "[checkpoint]") {
+TEST_CASE("a key the checkpoint's scene lacks, or holds and the scene lacks, counts as changed",
+          "[checkpoint]") {
   using fsi::changed_physics_key;
-  // A checkpoint from before fluid.body_viscosity was recorded ran the bodies as Kelvin-Voigt
-  // solids: the same explicitly continues it, the new default does not.
+  // Keys whose default changed (fluid.body_viscosity, fluid.implicit_forcing) are recorded in the
+  // effective scene since; a checkpoint without them predates protocol version 8 and is refused
+  // on its version before its scene is compared (check_checkpoint_version).
   const auto with = [&](const char* v) {
     return replaced(kScene, "viscosity = 0.01", std::string("viscosity = 0.01\nbody_viscosity = ") + v);
   };
-  CHECK(changed_physics_key(kScene, with("\"kelvin-voigt\"")).empty());
-  CHECK(changed_physics_key(kScene, with("'kelvin-voigt'")).empty());
+  CHECK(changed_physics_key(kScene, with("\"kelvin-voigt\"")) == "fluid.body_viscosity");
   CHECK(changed_physics_key(kScene, with("\"none\"")) == "fluid.body_viscosity");
   CHECK(changed_physics_key(with("\"none\""), with("\"kelvin-voigt\"")) == "fluid.body_viscosity");
   CHECK(changed_physics_key(with("\"kelvin-voigt\""), kScene) == "fluid.body_viscosity");
-  // Crank-Nicolson's forcing, recorded since its default became "increment".
-  const auto forcing = [&](const char* v) {
-    return replaced(kScene, "viscosity = 0.01",
-                    std::string("viscosity = 0.01\nimplicit_forcing = ") + v);
-  };
-  CHECK(changed_physics_key(kScene, forcing("\"after_solve\"")).empty());
-  CHECK(changed_physics_key(kScene, forcing("\"increment\"")) == "fluid.implicit_forcing");
-  // Any other key added at a restart still counts.
+  CHECK(changed_physics_key(with("\"none\""), with("\"none\"")).empty());
   CHECK(changed_physics_key(kScene, replaced(kScene, "viscosity = 0.01", "viscosity = 0.01\nforcing_time = 0.0")) ==
         "fluid.forcing_time");
 }
@@ -103,4 +97,25 @@ TEST_CASE("lists of vectors come back as they were, empty ones too", "[checkpoin
   fsi::H5File h5(path, fsi::H5File::Mode::read_only);
   CHECK(fsi::read_vectors(h5, "a") == v);
   CHECK(fsi::read_vectors(h5, "none").empty());
+}
+
+TEST_CASE("a checkpoint of another protocol version is refused, naming both", "[checkpoint]") {
+  const auto out = std::filesystem::temp_directory_path() / "fsi_test_checkpoint_version";
+  std::filesystem::remove_all(out);
+  const auto file = fsi::checkpoint_file(out, 100, fsi::Role::solid);
+  std::filesystem::create_directories(file.parent_path());
+  auto write = [&](std::int64_t version) {
+    fsi::H5File h5(file, fsi::H5File::Mode::truncate);
+    if (version >= 0) h5.set_attribute("/", "protocol_version", version);
+  };
+  write(fsi::proto::kVersion);
+  CHECK_NOTHROW(fsi::check_checkpoint_version(out, 100, fsi::Role::solid, "s.toml"));
+  write(7);
+  CHECK_THROWS_WITH(fsi::check_checkpoint_version(out, 100, fsi::Role::solid, "s.toml"),
+                    Catch::Contains("protocol version 7, this build speaks " +
+                                    std::to_string(fsi::proto::kVersion)));
+  write(-1);  // no attribute: written before the version was recorded
+  CHECK_THROWS_WITH(fsi::check_checkpoint_version(out, 100, fsi::Role::solid, "s.toml"),
+                    Catch::Contains("protocol version none recorded"));
+  std::filesystem::remove_all(out);
 }

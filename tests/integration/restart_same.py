@@ -85,6 +85,22 @@ def xdmf_times(folder):
     return out
 
 
+def steps_of(out):
+    """The steps of the complete-looking checkpoint folders of a run (step_<n>, n < 99999999)."""
+    steps = [int(os.path.basename(p)[5:]) for p in glob.glob(os.path.join(out, "checkpoint", "step_*"))]
+    return [n for n in steps if n < 99999999]
+
+
+def snapshot(folder):
+    """Every file under a folder with its size and modification time."""
+    out = {}
+    for root, _, files in os.walk(folder):
+        for f in files:
+            st = os.stat(os.path.join(root, f))
+            out[os.path.join(root, f)] = (st.st_size, st.st_mtime_ns)
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scene", required=True)
@@ -146,23 +162,32 @@ def main():
                          f"(exit {r.returncode}):\n{r.stderr[-2000:]}")
             print(f"restart_same: a restart with {a.change} is refused naming {a.key}")
         if a.older_version:
+            # On a copy of the stopped run, its files marked as written by older builds: the
+            # fluid's without the version (before it was recorded), the others' as version 7.
             import h5py
-            files = [p for p in glob.glob(os.path.join(stopped, "checkpoint", "step_*", "*.h5"))
-                     if "99999999" not in p]
-            kept = {}
-            for p in files:
+            older = stopped + "_older"
+            shutil.copytree(stopped, older)
+            step = max(steps_of(older))
+            for p in glob.glob(os.path.join(older, "checkpoint", f"step_{step:08d}", "*.h5")):
                 with h5py.File(p, "r+") as h5:
-                    kept[p] = h5.attrs["protocol_version"]
-                    h5.attrs["protocol_version"] = 7
-            r = subprocess.run(command(a.bin, full, ["--restart", stopped]), capture_output=True,
+                    if os.path.basename(p) == "fluid.h5":
+                        del h5.attrs["protocol_version"]
+                    else:
+                        h5.attrs["protocol_version"] = 7
+            before = snapshot(older)
+            r = subprocess.run(command(a.bin, full, ["--restart", older]), capture_output=True,
                                text=True, timeout=120)
-            for p, v in kept.items():
-                with h5py.File(p, "r+") as h5:
-                    h5.attrs["protocol_version"] = v
-            if r.returncode == 0 or "written by a build of protocol version 7" not in r.stderr:
-                sys.exit("restart_same: a checkpoint of protocol version 7 was not refused "
-                         f"(exit {r.returncode}):\n{r.stderr[-2000:]}")
-            print("restart_same: a checkpoint of protocol version 7 is refused")
+            expected = ["protocol version none recorded"]
+            if roles_of(a.bin, full) != ["fluid"]:
+                expected.append("protocol version 7,")
+            missing = [e for e in expected if e not in r.stderr]
+            if r.returncode == 0 or missing:
+                sys.exit(f"restart_same: checkpoints of older builds were not refused (exit "
+                         f"{r.returncode}; not said: {missing}):\n{r.stderr[-2000:]}")
+            if snapshot(older) != before:
+                sys.exit("restart_same: the refused restart changed the output folder")
+            shutil.rmtree(older)
+            print("restart_same: checkpoints of older builds are refused, the output untouched")
         log = run(a.bin, full, ["--restart", stopped], "restart", a.restart_ranks or a.fluid_ranks)
         print(log.strip().splitlines()[-1] if log.strip() else "")
     finally:
