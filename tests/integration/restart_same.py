@@ -135,7 +135,7 @@ def main():
             made.append(full)
             run(a.bin, full, ["--out-dir", straight, "--overwrite"], "run straight through")
             log = stop_by_signal(a.bin, full, stopped, a.fluid_ranks)
-            steps = sorted(int(os.path.basename(p)[5:]) for p in glob.glob(os.path.join(stopped, "checkpoint", "step_*")))
+            steps = sorted(steps_of(stopped))
             print(f"restart_same: stopped by the signal; checkpoints at steps {steps}")
             with open(os.path.join(stopped, "summary.json")) as f:
                 if "stopped_at_step" not in json.load(f):
