@@ -524,6 +524,13 @@ print("      footprint's boxes, each alpha read once (was: per face, its fluxes 
 print("      again, 11 to 13 reads a face) | most of the correction's 0.5 ms per step | h = 0,")
 print("      upwind3, 5000 steps from rest, one run before, two after: the fluid's predictor phase")
 print("      1.29 -> 1.02, 1.06 ms per step (Kelvin-Voigt folds 0.78); the same bits")
+print("  tried, not kept: the solid's factor kept across steps with open contact candidates (the")
+print("      wall planes, the self-contact; was: any slot made every step factorise ahead) | the")
+print("      look-ahead's 1.5 ms of CPU per step | h = 0 from its checkpoint at t = 0.5, 10 000")
+print("      steps, one run each: factorisations 10 012 -> 300, but Newton 2.17 -> 3.76 iterations")
+print("      per step (the held factor converges linearly, the look-ahead's exact one")
+print("      quadratically), solid round trip 1.28 -> 1.81 ms, 4.83 -> 5.21 ms per step: the")
+print("      look-ahead runs beside the fluid, off the critical path, so removing it gains nothing")
 PY
 }
 
