@@ -307,15 +307,7 @@ Config read_config(const fsi::SceneTable& f, double dt) {
                                       c.factored_helmholtz ? "factored" : "direct"));
   }
   c.bodies_inviscid = f.choice("body_viscosity", {"none", "kelvin-voigt"}, "none") == "none";
-  if (f.has("forcing_time")) {
-    c.forcing_time = f.non_negative("forcing_time");
-    if (c.implicit && c.forcing_in_increment)
-      f.fail("forcing_time", fmt::format("= {} applies to the forcing of the predictor, and "
-                                         "implicit_forcing = \"increment\" (Crank-Nicolson's "
-                                         "default) forces inside the solve: remove forcing_time, "
-                                         "or set implicit_forcing = \"after_solve\"",
-                                         c.forcing_time));
-  }
+  if (f.has("forcing_time")) c.forcing_time = f.non_negative("forcing_time");
   // Only when given: a scene without it keeps its effective scene as it was.
   if (f.has("upwind_blend")) c.upwind_blend = f.in_range("upwind_blend", 0.0, 1.0, false, 0.0);
   if (f.has("convection"))

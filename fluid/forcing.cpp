@@ -34,6 +34,15 @@ constexpr double kCovered = 1 - 1e-9;
 // dt. It is the implicit relaxation u = (u~ + K u_s)/(1 + K), K = alpha dt / ((1 - alpha) tau),
 // so 0 <= beta <= 1 for any dt: a contraction towards u_s, stable for any tau >= 0. tau = dt is
 // Eq. 21; tau = 0 holds every face the body touches at u_s (the limit dt -> 0 of Eq. 21).
+// The increment form blends u^ by the same beta before its solve, pull = beta (u_s - u^): its
+// steady state is the explicit balance u = (1 - beta)(u + dt R) + beta u_s above, so the slip
+// (1 - alpha)/alpha tau R holds there at any dt and any lambda.
+double Solver::forcing_fraction(double alpha, double dt) const {
+  const double tau = m_cfg.forcing_time;
+  if (tau < 0 || alpha <= 0) return alpha;
+  return alpha >= kCovered ? 1.0 : alpha * dt / ((1 - alpha) * tau + alpha * dt);
+}
+
 void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out) {
   const double rho = m_cfg.density;
   const int ny = m_grid.ny();
@@ -47,14 +56,9 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
               in.solid_u_index.size(), in.solid_v_index.size());
   // The force on one face, whose velocity is w (alpha a, body velocity ws, pull of the
   // increment's forcing).
-  const double tau = m_cfg.forcing_time;
-  auto blend = [&](double a) {
-    if (tau < 0 || a <= 0) return a;
-    return a >= kCovered ? 1.0 : a * dt / ((1 - a) * tau + a * dt);
-  };
   auto force = [&](double& w, double a, double ws, double pull) {
     if (cn) return rho * pull / dt;
-    const double f = rho * blend(a) * (ws - w) / dt;
+    const double f = rho * forcing_fraction(a, dt) * (ws - w) / dt;
     w += dt * f / rho;
     return f;
   };

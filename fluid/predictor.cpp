@@ -191,8 +191,8 @@ void Solver::solve_implicit(const CouplingIn& in) {
         buf[k] = scale * (f[i] - fn[i] + rhs[k]);
       }
     }
-    // implicit_forcing = "increment": the forcing on u^, alpha (u_s - u^), into the solve and
-    // kept for the reaction (immersed_forcing).
+    // implicit_forcing = "increment": the forcing on u^, alpha (u_s - u^) (beta with
+    // forcing_time, forcing.cpp), into the solve and kept for the reaction (immersed_forcing).
     if (m_cfg.forcing_in_increment) {
       const auto& idx = comp == 0 ? in.solid_u_index : in.solid_v_index;
       const auto& alpha = comp == 0 ? in.solid_u_alpha : in.solid_v_alpha;
@@ -202,7 +202,7 @@ void Solver::solve_implicit(const CouplingIn& in) {
       for (std::size_t q = 0; q < idx.size(); ++q) {
         const auto [i, j] = face_of(comp, idx[q]);
         if (i < ib || i >= nx || j < jb || owned(j, comp) >= ny) continue;
-        pull[q] = alpha[q] * (us[q] - F(i, j));
+        pull[q] = forcing_fraction(alpha[q], m_begun_dt) * (us[q] - F(i, j));
         buf[buf_index(i, j, ib, jb, nt)] += scale * pull[q];
       }
     }

@@ -158,6 +158,9 @@ class Solver {
   void add_fiber_force(double dt, const CouplingIn& fibers);                 // predictor.cpp
   void solve_implicit(const CouplingIn& in);                                 // predictor.cpp
   void immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out);  // forcing.cpp
+  // The fraction of the way to u_s a face of volume fraction alpha is forced in a step of dt:
+  // alpha (Eq. 21), or beta with forcing_time (forcing.cpp).
+  double forcing_fraction(double alpha, double dt) const;
   void remove_body_viscosity(double dt, const CouplingIn& in);  // body_viscosity.cpp
   // dt, and the time whose boundary pressures p^(n+1) takes (t^n + dt; t^n for project_initial).
   void project(double dt, double t_new);                                    // projection.cpp

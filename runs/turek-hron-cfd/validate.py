@@ -23,7 +23,8 @@ OUT/body-viscosity-X. Since protocol version 8 "none" leaves the rigid cylinder 
 so both give the same forces here; the README's "none" table was measured before.
 `--implicit-forcing increment|after_solve`: fluid.implicit_forcing written into the scenes
 (increment, the fluid's default; after_solve: the forcing of the tables measured before it), every
-output under OUT/implicit-forcing-X; `--forcing-time` writes after_solve (it blends that forcing).
+output under OUT/implicit-forcing-X. `--forcing-time` blends either forcing (the README's
+forcing-time tables before this release took after_solve: `--implicit-forcing after_solve`).
 Environment (set by `./fsi validate`): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN."""
 import glob
 import json
@@ -71,11 +72,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 job.out_dir("turek-hron-cfd")
 OUT = job.nest(ARGS.body_viscosity and f"body-viscosity-{ARGS.body_viscosity}",
                ARGS.implicit_forcing and f"implicit-forcing-{ARGS.implicit_forcing}")
-# fluid.forcing_time blends the forcing of the predictor, which the Crank-Nicolson default
-# ("increment") does not take: a forcing time runs the forcing after the solve.
-FORCING = "after_solve" if ARGS.forcing_time is not None else ARGS.implicit_forcing
-if ARGS.forcing_time is not None and ARGS.implicit_forcing == "increment":
-    _p.error("--forcing-time takes the forcing after the solve: drop --implicit-forcing increment")
+FORCING = ARGS.implicit_forcing
 
 H, L = 0.41, 2.5
 TAU_TAG = "" if ARGS.forcing_time is None else f"-tau{ARGS.forcing_time:g}"

@@ -136,7 +136,7 @@ TEST_CASE("convection: central by default, upwind3, anything else refused",
   CHECK_NOTHROW(read(std::string(kGood) + "\n[fluid.substeps]\nmax = 4\n"));
 }
 
-TEST_CASE("forcing_time: read, refused negative or with the increment forcing",
+TEST_CASE("forcing_time: read with every diffusion and forcing, refused negative",
           "[fluid][config]") {
   auto with = [](const std::string& keys) {
     return replace(kGood, "viscosity = 0.01", "viscosity = 0.01\n" + keys);
@@ -146,15 +146,13 @@ TEST_CASE("forcing_time: read, refused negative or with the increment forcing",
   CHECK(read(with("forcing_time = 0")).forcing_time == 0.0);
   const std::string after_solve = "diffusion = \"implicit\"\nimplicit_forcing = \"after_solve\"";
   CHECK(read(with(after_solve + "\nforcing_time = 1e-3")).forcing_time == 1e-3);
-  // Crank-Nicolson's default forcing is inside its solve: the key must name "after_solve".
-  CHECK_THROWS_WITH(read(with("diffusion = \"implicit\"\nforcing_time = 1e-3")),
-                    Contains("forcing_time") && Contains("after_solve"));
+  // Crank-Nicolson's default forcing, inside its solve, blends by the same beta.
+  CHECK(read(with("diffusion = \"implicit\"\nforcing_time = 1e-3")).forcing_time == 1e-3);
   CHECK_THROWS_WITH(read(with("forcing_time = -1e-3")),
                     Contains("forcing_time") && Contains("-0.001"));
   CHECK_THROWS_WITH(read(with("forcing_time = inf")), Contains("forcing_time") && Contains("inf"));
-  CHECK_THROWS_WITH(
-      read(with("diffusion = \"implicit\"\nimplicit_forcing = \"increment\"\nforcing_time = 1e-3")),
-      Contains("forcing_time") && Contains("increment"));
+  CHECK(read(with("diffusion = \"implicit\"\nimplicit_forcing = \"increment\"\nforcing_time = 0"))
+            .forcing_time == 0.0);
 }
 
 TEST_CASE("implicit_forcing: read with Crank-Nicolson, refused without it or unknown",

@@ -495,10 +495,10 @@ namespace {
 // (alpha = 1), the next one cut (alpha = 0.4). Driven by a body force (periodic in x) or by the
 // pressure 0.02 at x = 0 against 0 at x = 1 (pressure sides: the predictor carries grad p^n).
 enum Drive { body_force, pressure_drop };
-Config wall_layer_channel(Drive drive, double tau) {
-  Config c = box(drive == body_force ? BcType::periodic : BcType::pressure);
+Config wall_layer_channel(Drive drive, double tau, Diffusion d = explicit_ab2, double g = 2.0) {
+  Config c = with(box(drive == body_force ? BcType::periodic : BcType::pressure), d);
   if (drive == body_force)
-    c.body = {2.0, 0.0};
+    c.body = {g, 0.0};
   else
     c.bc[left].value = 0.02;
   c.forcing_time = tau;
@@ -514,8 +514,9 @@ struct WallLayer : UFaceInput {
 };
 
 // The steady u along a column after t = 150 at time step dt (< 0 tau: Eq. 21 as written).
-std::vector<double> steady_channel(double dt, double tau, Drive drive = body_force) {
-  Solver s(wall_layer_channel(drive, tau), dt);
+std::vector<double> steady_channel(double dt, double tau, Drive drive = body_force,
+                                   Diffusion d = explicit_ab2, double g = 2.0) {
+  Solver s(wall_layer_channel(drive, tau, d, g), dt);
   const WallLayer layer(s.grid());
   CouplingOut out;
   const int steps = static_cast<int>(std::lround(150.0 / dt));
@@ -524,17 +525,18 @@ std::vector<double> steady_channel(double dt, double tau, Drive drive = body_for
   for (int j = 0; j < s.grid().ny(); ++j) u.push_back(s.u()(3, j));
   return u;
 }
+// The largest difference of two profiles relative to the first's largest value.
+double gap(const std::vector<double>& a, const std::vector<double>& b) {
+  double d = 0, m = 0;
+  for (std::size_t j = 0; j < a.size(); ++j)
+    d = std::max(d, std::abs(a[j] - b[j])), m = std::max(m, std::abs(a[j]));
+  return d / m;
+}
 }  // namespace
 
 TEST_CASE("forcing_time: a steady flow's slip in cut faces does not depend on dt",
           "[fluid][coupling]") {
   // lambda = nu dt / h^2 = 2.56 dt at h = 1/16: dt = 0.04 and 0.02 (lambda 0.10, 0.05).
-  auto gap = [](const std::vector<double>& a, const std::vector<double>& b) {
-    double d = 0, m = 0;
-    for (std::size_t j = 0; j < a.size(); ++j)
-      d = std::max(d, std::abs(a[j] - b[j])), m = std::max(m, std::abs(a[j]));
-    return d / m;
-  };
   for (Drive drive : {body_force, pressure_drop}) {
     CAPTURE(drive);
     const auto paper_coarse = steady_channel(0.04, -1, drive);
@@ -549,6 +551,30 @@ TEST_CASE("forcing_time: a steady flow's slip in cut faces does not depend on dt
     CHECK(std::abs(pinned[1]) < 1e-12 * pinned[4]);
     CHECK(gap(pinned, steady_channel(0.02, 0.0, drive)) < 1e-12);
   }
+}
+
+// Crank-Nicolson with the forcing in its increment blends u^ by the same beta: its steady state
+// is the explicit balance, so the slip does not depend on dt at any lambda (here up to 2: an
+// implicit step of ten times the explicit one's). Periodic only: Crank-Nicolson has no pressure
+// sides.
+TEST_CASE("forcing_time with Crank-Nicolson's increment forcing: the slip does not depend on dt",
+          "[fluid][coupling]") {
+  // lambda = 2.56 dt: dt = 0.8, 0.2 (lambda 2.05, 0.51); a weak drive (u <= 0.02) keeps the
+  // explicit convection's CFL number below 0.3 at the larger step.
+  const double g = 0.02;
+  auto steady = [&](double dt, double tau, Diffusion d) {
+    return steady_channel(dt, tau, body_force, d, g);
+  };
+  // Eq. 21 as written: the cut face's slip (1 - alpha)/alpha dt R moves the profile with dt.
+  CHECK(gap(steady(0.8, -1, crank_nicolson), steady(0.2, -1, crank_nicolson)) > 1e-2);
+  // With tau: one steady state whatever dt, and the explicit scheme's at the same tau.
+  const auto relaxed = steady(0.8, 0.02, crank_nicolson);
+  CHECK(gap(relaxed, steady(0.2, 0.02, crank_nicolson)) < 1e-12);
+  CHECK(gap(relaxed, steady(0.02, 0.02, explicit_ab2)) < 1e-12);
+  // tau = 0 holds the cut face at rest at any lambda.
+  const auto pinned = steady(0.8, 0.0, crank_nicolson);
+  CHECK(std::abs(pinned[1]) < 1e-12 * pinned[4]);
+  CHECK(gap(pinned, steady(0.2, 0.0, crank_nicolson)) < 1e-12);
 }
 
 TEST_CASE("forcing_time = dt is Eq. 21 step by step, the returned force too",
