@@ -8,22 +8,6 @@ namespace {
 constexpr double kCovered = 1 - 1e-9;
 }  // namespace
 
-// Immersed solid (paper Eq. 21): f_s = rho_f alpha (u_s - u~) / dt, then u~ += dt f_s / rho_f,
-// i.e. u~ <- (1 - alpha) u~ + alpha u_s, on the solid's faces (the u faces the step solves for:
-// the interior and a pressure side's boundary faces; Crank-Nicolson has no pressure sides).
-//
-// Crank-Nicolson in increment form (implicit_forcing = "increment", predictor.cpp) forced its
-// explicit prediction before the solve, pull = alpha (u_s - u^), and f_s = rho_f pull / dt: the
-// momentum the forcing put into the solve. The faces keep the solve's values, the covered ones
-// too. Its step, with A = I - (nu dt/2) L, D = diag(1 - alpha) and the body at rest,
-//   u^(n+1) = u^n + A^-1 (D (I + nu dt L) u^n - u^n),
-// has the explicit balance u = D (I + nu dt L) u as its steady state (u = u_s on a covered face),
-// and is stable at any lambda = nu dt / h^2 in a model of a wall (runs/sub-cell-wall/README.md).
-// Setting the covered faces to u_s after the solve, as an earlier form did, made it unstable from
-// lambda ~ 5: the solve treats the covered faces as fluid, so it gives the free faces next to
-// the body a larger increment than a solve with those faces held would, and the mode there grew
-// by a factor below -1 per step. A coupled iteration's redo solves again with its alpha and u_s.
-//
 // The relaxation time tau (fluid.forcing_time). The predictor carries the pressure gradient of
 // step n, u~ = u^n + dt R (R: convection, diffusion, -grad p^n, body force), so in a steady flow
 // the projection's increment vanishes, u^(n+1) = u^n = u, and a face blended by beta keeps
@@ -36,13 +20,31 @@ constexpr double kCovered = 1 - 1e-9;
 // Eq. 21; tau = 0 holds every face the body touches at u_s (the limit dt -> 0 of Eq. 21).
 // The increment form blends u^ by the same beta before its solve, pull = beta (u_s - u^): its
 // steady state is the explicit balance u = (1 - beta)(u + dt R) + beta u_s above, so the slip
-// (1 - alpha)/alpha tau R holds there at any dt and any lambda.
+// (1 - alpha)/alpha tau R holds there at any dt and any lambda (tau = 0: u = u_s on a touched
+// face at a steady state; within a step the faces keep the solve's values, as covered ones do).
 double Solver::forcing_fraction(double alpha, double dt) const {
   const double tau = m_cfg.forcing_time;
   if (tau < 0 || alpha <= 0) return alpha;
   return alpha >= kCovered ? 1.0 : alpha * dt / ((1 - alpha) * tau + alpha * dt);
 }
 
+// Immersed solid (paper Eq. 21): f_s = rho_f alpha (u_s - u~) / dt (beta with forcing_time:
+// forcing_fraction above), then u~ += dt f_s / rho_f, i.e. u~ <- (1 - alpha) u~ + alpha u_s, on
+// the solid's faces (the u faces the step solves for: the interior and a pressure side's
+// boundary faces; Crank-Nicolson has no pressure sides).
+//
+// Crank-Nicolson in increment form (implicit_forcing = "increment", predictor.cpp) forced its
+// explicit prediction before the solve, pull = alpha (u_s - u^) (beta with forcing_time), and
+// f_s = rho_f pull / dt: the momentum the forcing put into the solve. The faces keep the solve's
+// values, the covered ones too. Its step, with A = I - (nu dt/2) L, D = diag(1 - alpha) and the
+// body at rest,
+//   u^(n+1) = u^n + A^-1 (D (I + nu dt L) u^n - u^n),
+// has the explicit balance u = D (I + nu dt L) u as its steady state (u = u_s on a covered face),
+// and is stable at any lambda = nu dt / h^2 in a model of a wall (runs/sub-cell-wall/README.md).
+// Setting the covered faces to u_s after the solve, as an earlier form did, made it unstable from
+// lambda ~ 5: the solve treats the covered faces as fluid, so it gives the free faces next to
+// the body a larger increment than a solve with those faces held would, and the mode there grew
+// by a factor below -1 per step. A coupled iteration's redo solves again with its alpha and u_s.
 void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out) {
   const double rho = m_cfg.density;
   const int ny = m_grid.ny();

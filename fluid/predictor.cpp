@@ -84,18 +84,18 @@ void Solver::add_fiber_force(double dt, const CouplingIn& in) {
 // with u~ = u^n + Y, the same as
 //   u^ = u^n + dt R + 2 theta L(u^n; b^n)                  (an explicit prediction)
 //   (I - theta L0) Y = u^ - u^n + theta [L(u^n; b^(n+1)) - L(u^n; b^n)].
-// The immersed solid's forcing with implicit_forcing = "increment" acts on u^ before
-// the solve, u^_f = u^ + alpha (u_s - u^): the solve takes u^_f - u^n in place of u^ - u^n, and
-// u~ = u^n + Y; every face keeps the solve's value (forcing.cpp: why the covered ones too). In a
-// steady state with u^_f = u^n (the explicit scheme's balance) Y = 0 and u~ = u^n: the wall sits
-// where the explicit scheme puts it, at any lambda = nu dt / h^2; and as u~ - u^n is always a
-// solve's result, the explicit diffusion in u^ never reaches u~ undamped (forcing a cut face
-// after the solve as well would leave alpha (1 - alpha) of it there, unstable from lambda of
-// about 0.5). The reaction is what the forcing put in: rho alpha (u_s - u^) / dt. The solve's
-// faces are the interior ones: Crank-Nicolson has no pressure sides (config.cpp). Without a
-// body the step is the classical one; "after_solve" forces u~ after the solve as the explicit
-// scheme does (the solve then acts on the unforced prediction inside the body, and the wall
-// leaks).
+// The immersed solid's forcing with implicit_forcing = "increment" acts on u^ before the solve,
+// u^_f = u^ + alpha (u_s - u^) (beta with forcing_time, forcing.cpp): the solve takes u^_f - u^n
+// in place of u^ - u^n, and u~ = u^n + Y; every face keeps the solve's value (forcing.cpp: why
+// the covered ones too). In a steady state with u^_f = u^n (the explicit scheme's balance) Y = 0
+// and u~ = u^n: the wall sits where the explicit scheme puts it, at any lambda = nu dt / h^2; and
+// as u~ - u^n is always a solve's result, the explicit diffusion in u^ never reaches u~ undamped
+// (forcing a cut face after the solve as well would leave alpha (1 - alpha) of it there, unstable
+// from lambda of about 0.5). The reaction is what the forcing put in: rho alpha (u_s - u^) / dt
+// (beta with forcing_time). The solve's faces are the interior ones: Crank-Nicolson has no
+// pressure sides (config.cpp). Without a body the step is the classical one; "after_solve" forces
+// u~ after the solve as the explicit scheme does (the solve then acts on the unforced prediction
+// inside the body, and the wall leaks).
 //
 // This part runs before the coupling input: u^ into the fields' unknowns (the boundary faces and
 // ghosts hold t^(n+1)'s values), and the boundary increment theta [L(u^n; b^(n+1)) - L(u^n; b^n)]
@@ -169,9 +169,10 @@ void Solver::predictor_implicit(double dt, double t_half) {
 }
 
 // The Crank-Nicolson solve of the step (predictor_implicit): the forcing alpha (u_s - u^) on u^
-// (kept in m_pull for the reaction), (I - theta L0) Y = u^_f - u^n + boundary increment,
-// u~ = u^n + Y. A coupled iteration's redo takes u^ again and solves with its alpha and u_s
-// (forcing.cpp: why the faces keep the solve's values).
+// (beta with forcing_time; kept in m_pull for the reaction),
+// (I - theta L0) Y = u^_f - u^n + boundary increment, u~ = u^n + Y. A coupled iteration's redo
+// takes u^ again and solves with its alpha and u_s (forcing.cpp: why the faces keep the solve's
+// values).
 void Solver::solve_implicit(const CouplingIn& in) {
   const int nx = m_grid.nx(), ny = m_grid.ny();
   const double scale = -1.0 / (0.5 * m_nu * m_begun_dt);  // the Helmholtz solver's B / -theta

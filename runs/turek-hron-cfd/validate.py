@@ -72,6 +72,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 job.out_dir("turek-hron-cfd")
 OUT = job.nest(ARGS.body_viscosity and f"body-viscosity-{ARGS.body_viscosity}",
                ARGS.implicit_forcing and f"implicit-forcing-{ARGS.implicit_forcing}")
+# Crank-Nicolson's forcing written into the scenes (None: not written, the fluid's "increment");
+# each choice has its own output folder (OUT), so the --bands-xy JSONs of the two do not mix.
 FORCING = ARGS.implicit_forcing
 
 H, L = 0.41, 2.5
@@ -403,7 +405,8 @@ def bands_xy(levels=None, dts=None, cases=("cfd1", "cfd2"), out="bands_xy.json")
                 t, fx, fy = forces(folder)
                 d, l = analyse(t, fx, 2.0), analyse(t, fy, 2.0)
                 r = {"case": case, "cells": [nx, ny], "x_band": xb, "y_band": yb, "band_h": hb,
-                     "dt": dt, "forcing_time": ARGS.forcing_time, "wall_s": wall, "cpu_s": cpu,
+                     "dt": dt, "forcing_time": ARGS.forcing_time,
+                     "implicit_forcing": FORCING or "increment", "wall_s": wall, "cpu_s": cpu,
                      "steps": outputs.summary(folder)["steps"],
                      "drag": d, "lift": l, "drag_error": d["value"] / ref["drag"] - 1.0,
                      "lift_error": l["value"] / ref["lift"] - 1.0}
