@@ -205,8 +205,26 @@ void ContactSet::detect(const std::vector<const std::vector<double>*>& x,
   for (std::size_t b = 0; b < m_self_slot.size(); ++b)
     if (!m_self_slot[b].empty())
       bin_edges(m_surfaces[b], *x[b], kSelfSearch * reach[b], m_self_bins[b]);
-  for (auto& s : m_slots) detect_slot(s, x, boxes, reach[s.slave_body]);
+  m_reach.assign(reach.begin(), reach.end());
+  for (std::size_t k = 0; k < m_slots.size(); ++k) {
+    ContactSlot& s = m_slots[k];
+    if (m_hold && m_held[k])
+      hold_slot(s, x);
+    else
+      detect_slot(s, x, boxes, reach[s.slave_body]);
+  }
   join_vertex_pairs(x);
+}
+
+void ContactSet::hold_features(bool on) {
+  m_hold = on;
+  m_held.assign(on ? m_slots.size() : 0, 0);
+  if (!on) return;
+  for (std::size_t k = 0; k < m_slots.size(); ++k) {
+    const ContactSlot& s = m_slots[k];
+    const double reach = s.slave_body < static_cast<int>(m_reach.size()) ? m_reach[s.slave_body] : 0;
+    m_held[k] = s.plane < 0 && s.m0 >= 0 && (s.active || s.gap < reach);
+  }
 }
 
 // Bins of about the search distance (at most kMaxBins along a side), each edge entered in every
@@ -313,6 +331,93 @@ void ContactSet::join_vertex_pairs(const std::vector<const std::vector<double>*>
   }
 }
 
+namespace {
+// The slot's feature the edge from (ax, ay) along (ex, ey), at parameter xi (as given: clamped or
+// not): its unit normal (the master body on its left) and the signed distance of (px, py) from
+// the edge's point at xi along that normal.
+void set_edge(ContactSlot& s, double ax, double ay, double ex, double ey, double xi, double px,
+              double py) {
+  const double le = std::hypot(ex, ey);
+  s.xi = xi;
+  s.normal = {ey / le, -ex / le};
+  s.gap = (px - ax - xi * ex) * s.normal[0] + (py - ay - xi * ey) * s.normal[1];
+}
+
+// Surface edge k's unit normal (the body on its left) at positions pos.
+Vec2 edge_normal(const Mesh& mesh, const std::vector<double>& pos, int k) {
+  const auto& e = mesh.surface[k];
+  const double dx = pos[2 * e[1]] - pos[2 * e[0]], dy = pos[2 * e[1] + 1] - pos[2 * e[0] + 1];
+  const double l = std::hypot(dx, dy);
+  return Vec2{dy / l, -dx / l};
+}
+}  // namespace
+
+Vec2 ContactSet::pseudo_normal(const Surface& surf, const std::vector<double>& pos, int v) {
+  Vec2 nv{0, 0};
+  for (int j : surf.vertex_edges[v]) {
+    const Vec2 nj = edge_normal(*surf.mesh, pos, j);
+    nv[0] += nj[0], nv[1] += nj[1];
+  }
+  return nv;
+}
+
+double ContactSet::vertex_gap(const Surface& surf, const std::vector<double>& pos, int v,
+                              double qx, double qy, const Vec2& n_v) {
+  double nearest = std::numeric_limits<double>::max(), g = 0;
+  for (int j : surf.vertex_edges[v]) {
+    const auto& ej = surf.mesh->surface[j];
+    const double bx = pos[2 * ej[0]], by = pos[2 * ej[0] + 1];
+    const double fx = pos[2 * ej[1]] - bx, fy = pos[2 * ej[1] + 1] - by;
+    const double t = std::clamp(((qx - bx) * fx + (qy - by) * fy) / (fx * fx + fy * fy), 0.0, 1.0);
+    const double rx = qx - bx - t * fx, ry = qy - by - t * fy;
+    const double dj = std::hypot(rx, ry);
+    if (dj >= nearest) continue;
+    nearest = dj;
+    const Vec2 nj = t > 0 && t < 1 ? edge_normal(*surf.mesh, pos, j) : n_v;
+    g = rx * nj[0] + ry * nj[1] < 0 ? -dj : dj;
+  }
+  return g;
+}
+
+// A held slot (hold_features): its feature's gap and normal at the positions x, as detection
+// takes them for that feature, without looking for another. An edge is the line through it
+// (the parameter not clamped: the node may slide past its end while held); a vertex zone
+// (self-contact) the pseudo-normal with the distance to the nearer of its edges; another vertex
+// the direction from it, on the side detection finds (ray casting between two bodies, the
+// pseudo-normal on the body's own surface).
+void ContactSet::hold_slot(ContactSlot& s, const std::vector<const std::vector<double>*>& x) const {
+  const std::vector<double>& xs = *x[s.slave_body];
+  const std::vector<double>& xm = *x[s.master_body];
+  const double px = xs[2 * s.slave_node], py = xs[2 * s.slave_node + 1];
+  const Surface& surf = m_surfaces[s.master_body];
+  if (s.m1 >= 0) {
+    const double ax = xm[2 * s.m0], ay = xm[2 * s.m0 + 1];
+    const double ex = xm[2 * s.m1] - ax, ey = xm[2 * s.m1 + 1] - ay;
+    set_edge(s, ax, ay, ex, ey, ((px - ax) * ex + (py - ay) * ey) / (ex * ex + ey * ey), px, py);
+    return;
+  }
+  const int v = s.m0;
+  const bool self = s.master_body == s.slave_body;
+  const Vec2 nv = self ? pseudo_normal(surf, xm, v) : Vec2{0, 0};
+  const double ln = std::hypot(nv[0], nv[1]);
+  if (s.zone && ln > 1e-6) {
+    s.normal = {nv[0] / ln, nv[1] / ln};
+    s.gap = vertex_gap(surf, xm, v, px, py, s.normal);
+    return;
+  }
+  s.zone = false;  // (a zone whose vertex's edges now fold back onto each other: detect_self)
+  const double qx = px - xm[2 * v], qy = py - xm[2 * v + 1];
+  const double d = std::hypot(qx, qy);
+  if (d == 0) {  // on the vertex: no direction from it; the last normal stays
+    s.gap = 0;
+    return;
+  }
+  const double sign = self ? (qx * nv[0] + qy * nv[1] < 0 ? -1.0 : 1.0)
+                           : (inside_surface(*surf.mesh, xm, px, py) ? -1.0 : 1.0);
+  s.normal = {sign * qx / d, sign * qy / d};
+  s.gap = sign * d;
+}
+
 void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector<double>*>& x,
                              const std::vector<std::array<double, 4>>& boxes,
                              double reach) const {
@@ -386,13 +491,9 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
     const double ex = xm[2 * e[1]] - xm[2 * e[0]], ey = xm[2 * e[1] + 1] - xm[2 * e[0] + 1];
     const double margin = kKeepEdge * kKeepEdge * (ex * ex + ey * ey);
     if (std::sqrt(last_d2) <= std::sqrt(best) + std::sqrt(margin)) {
-      const double ax = xm[2 * e[0]], ay = xm[2 * e[0] + 1];
-      const double le = std::hypot(ex, ey);
       s.m0 = e[0];
       s.m1 = e[1];
-      s.xi = last_xi;
-      s.normal = {ey / le, -ex / le};
-      s.gap = (px - ax - last_xi * ex) * s.normal[0] + (py - ay - last_xi * ey) * s.normal[1];
+      set_edge(s, xm[2 * e[0]], xm[2 * e[0] + 1], ex, ey, last_xi, px, py);
       return;
     }
   }
@@ -414,9 +515,7 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
   }
   s.m0 = e[0];
   s.m1 = e[1];
-  s.xi = best_xi;
-  s.normal = {ey / le, -ex / le};
-  s.gap = (px - ax - best_xi * ex) * s.normal[0] + (py - ay - best_xi * ey) * s.normal[1];
+  set_edge(s, ax, ay, ex, ey, best_xi, px, py);
 }
 
 // Self-contact, a node of a body against its own surface. Three differences from two bodies:
@@ -463,42 +562,6 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     const auto& e = mesh.surface[k];
     return std::hypot(x[2 * e[1]] - x[2 * e[0]], x[2 * e[1] + 1] - x[2 * e[0] + 1]);
   };
-  // Edge k's unit normal (the body on its left) at positions `pos`.
-  auto normal_at = [&](const std::vector<double>& pos, int k) {
-    const auto& e = mesh.surface[k];
-    const double dx = pos[2 * e[1]] - pos[2 * e[0]], dy = pos[2 * e[1] + 1] - pos[2 * e[0] + 1];
-    const double l = std::hypot(dx, dy);
-    return Vec2{dy / l, -dx / l};
-  };
-  // The sum of the normals of the edges at vertex v (not normalised), at positions `pos`.
-  auto pseudo_normal_at = [&](const std::vector<double>& pos, int v) {
-    Vec2 nv{0, 0};
-    for (int j : surf.vertex_edges[v]) {
-      const Vec2 nj = normal_at(pos, j);
-      nv[0] += nj[0], nv[1] += nj[1];
-    }
-    return nv;
-  };
-  auto pseudo_normal = [&](int v) { return pseudo_normal_at(x, v); };
-  // The signed distance from (qx, qy) to the nearer of vertex v's edges at positions `pos`: its
-  // sign from that edge's normal for a projection inside it, from n_v (v's pseudo-normal there)
-  // at v itself. 0 for a vertex without edges.
-  auto vertex_gap = [&](const std::vector<double>& pos, int v, double qx, double qy, const Vec2& n_v) {
-    double nearest = std::numeric_limits<double>::max(), g = 0;
-    for (int j : surf.vertex_edges[v]) {
-      const auto& ej = mesh.surface[j];
-      const double bx = pos[2 * ej[0]], by = pos[2 * ej[0] + 1];
-      const double fx = pos[2 * ej[1]] - bx, fy = pos[2 * ej[1] + 1] - by;
-      const double t = std::clamp(((qx - bx) * fx + (qy - by) * fy) / (fx * fx + fy * fy), 0.0, 1.0);
-      const double rx = qx - bx - t * fx, ry = qy - by - t * fy;
-      const double dj = std::hypot(rx, ry);
-      if (dj >= nearest) continue;
-      nearest = dj;
-      const Vec2 nj = t > 0 && t < 1 ? normal_at(pos, j) : n_v;
-      g = rx * nj[0] + ry * nj[1] < 0 ? -dj : dj;
-    }
-    return g;
-  };
   // Whether the node was in front of (or on) the feature at the step's start (`start`, the
   // body's positions then; none given: yes): the feature's point under it then (the vertex, or
   // the edge's point at the same xi), its normal then (the pseudo-normal, or the edge's), and
@@ -513,7 +576,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     const double sx = start[2 * s.slave_node], sy = start[2 * s.slave_node + 1];
     if (vertex) {  // as the gap is taken at a vertex: to the nearer of its two edges
       const int v = xi <= 0 ? e[0] : e[1];
-      return vertex_gap(start, v, sx, sy, pseudo_normal_at(start, v)) >= floor;
+      return vertex_gap(surf, start, v, sx, sy, pseudo_normal(surf, start, v)) >= floor;
     }
     const double w = std::clamp(xi, 0.0, 1.0);
     const double ax0 = start[2 * e[0]], ay0 = start[2 * e[0] + 1];
@@ -612,12 +675,12 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
       const double r = kSelfVertexZone * shortest * (s.zone && s.m0 == v ? 2 : 1);
       if (std::hypot(px - x[2 * v], py - x[2 * v + 1]) <= r) zone = v;
     }
-    const Vec2 nv = zone >= 0 ? pseudo_normal(zone) : Vec2{0, 0};
+    const Vec2 nv = zone >= 0 ? pseudo_normal(surf, x, zone) : Vec2{0, 0};
     const double ln = std::hypot(nv[0], nv[1]);
     const bool in_zone = zone >= 0 && ln > 1e-6;
     if (in_zone) {  // (a vertex whose edges fold back onto each other has no pseudo-normal)
       n = {nv[0] / ln, nv[1] / ln};
-      g = vertex_gap(x, zone, px, py, n);
+      g = vertex_gap(surf, x, zone, px, py, n);
       vertex = true;
       xi = zone == e[0] ? 0 : 1;
     } else if (vertex) {
@@ -636,7 +699,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
         const double tb = qx * (x[2 * out[1]] - x[2 * v]) + qy * (x[2 * out[1] + 1] - x[2 * v + 1]);
         if (ta < 0 || tb > 0) continue;
       }
-      const Vec2 nv = pseudo_normal(v);
+      const Vec2 nv = pseudo_normal(surf, x, v);
       const double sign = qx * nv[0] + qy * nv[1] < 0 ? -1.0 : 1.0;
       n = {sign * qx / d, sign * qy / d};
       g = sign * d;

@@ -55,6 +55,15 @@ class ContactSet {
   // start of every step from the last detection. Without positions, a node may be found up
   // to one reach behind any feature, and at any depth behind a guarded one (see detect_self).
   void remember_fronts(const std::vector<const std::vector<double>*>& x = {}, double gap_tol = 0);
+  // Held features: within a Newton solve that has come back to an earlier iterate's residual
+  // (a cycle among the discrete choices of detection: which edge, which vertex zone, a joined
+  // pair; newton.cpp), every slot that is active or a candidate (a feature within one reach at
+  // the last detection) keeps its feature, and detect() only evaluates that feature's gap and
+  // normal at the new positions (hold_slot): the conditions are then one smooth set. The other
+  // slots are detected as always. The solver releases the hold at the start and at the end of
+  // every solve, and checks a state reached under it with a detection without it.
+  void hold_features(bool on);
+  bool holds_features() const { return m_hold; }
   std::vector<ContactSlot>& slots() { return m_slots; }
   const std::vector<ContactSlot>& slots() const { return m_slots; }
 
@@ -85,12 +94,23 @@ class ContactSet {
   void detect_self(ContactSlot& s, const std::array<int, 2>& front, const std::vector<double>& x,
                    double reach, const EdgeBins& bins) const;
   void join_vertex_pairs(const std::vector<const std::vector<double>*>& x);
+  void hold_slot(ContactSlot& s, const std::vector<const std::vector<double>*>& x) const;
+  // Self-contact geometry at positions pos (detect_self, hold_slot): the sum of the unit normals
+  // of the surface edges at vertex v (its pseudo-normal, not normalised), and the signed distance
+  // from q to the nearer of v's edges (its sign from that edge's normal for a projection inside
+  // it, from n_v at v itself; 0 for a vertex without edges).
+  static Vec2 pseudo_normal(const Surface& surf, const std::vector<double>& pos, int v);
+  static double vertex_gap(const Surface& surf, const std::vector<double>& pos, int v, double qx,
+                           double qy, const Vec2& n_v);
   std::vector<Surface> m_surfaces;
   std::vector<ContactPlane> m_planes;
   std::vector<ContactSlot> m_slots;
   std::vector<std::array<int, 2>> m_front;  // per slot (self-contact), remember_fronts
   std::vector<std::vector<double>> m_start;  // per body (self-contact), remember_fronts
   double m_gap_tol = 0;                       // remember_fronts
+  bool m_hold = false;                        // hold_features
+  std::vector<char> m_held;                   // per slot, while m_hold: its feature is kept
+  std::vector<double> m_reach;                // per body, of the last detect()
   std::vector<std::vector<int>> m_self_slot;  // per body, per node: its self-contact slot or -1
   std::vector<EdgeBins> m_self_bins;          // per body (self-contact), detect
 };

@@ -2,6 +2,7 @@
 // linearised in every iteration (contact_solve.cpp): assemble the residual and tangent at the
 // iterate, add the contact terms, test convergence, factorise and solve, update the iterate.
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <cmath>
 #include <limits>
@@ -47,6 +48,30 @@ constexpr double kReuseRatio = 1e-2;
 // four solves (a residual 1e11 above its tolerance); a slower one factorises ahead again.
 constexpr double kKeepRatio = 1e-3;
 
+// A Newton solve whose residual comes back, within this relative difference, to its value two
+// to kCyclePeriod iterations before cycles: detection's discrete choices (an edge or its
+// neighbour, a vertex zone or its edge, a joined pair or two slots) send the iterate back and
+// forth. From then on each contact keeps its feature (ContactSet::hold_features). Seen: a fold's
+// node at a creased vertex, 2 % of an edge from it (the zone's border), the pseudo-normal and
+// the edge's normal 52 degrees apart, a cycle of period four (residuals 1.8e4, 8.1e2, 1.4e1,
+// 2.0e4, 1.8e4, ...) through every cutback (vocal folds at h = 0 with the predictor, t = 6.94).
+constexpr double kCycleMatch = 1e-3;
+constexpr std::size_t kCyclePeriod = 4;
+// A state converged with held features may have a node this far (relative to its smallest
+// surface edge) through a surface by detection without the hold: twice the vertex zone's radius
+// (contact.cpp, kSelfVertexZone), the most a joined pair's gap is off the distance.
+constexpr double kHeldGapSlack = 0.02;
+// Holds noted on stderr; later ones are only counted (contact_feature_holds).
+constexpr long kHoldNotes = 10;
+
+// Whether the last residual repeats one of 2 to kCyclePeriod iterations before.
+bool revisits(const std::vector<double>& r) {
+  const std::size_t n = r.size();
+  for (std::size_t p = 2; p <= kCyclePeriod && p < n; ++p)
+    if (std::abs(r[n - 1] - r[n - 1 - p]) <= kCycleMatch * r[n - 1]) return true;
+  return false;
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -83,6 +108,12 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
   m_ahead_fresh = false;
   bool reused_in_contact = false;   // the last iteration solved with a held factor, in contact
   bool contact_reuse_failed = false;  // and its residual did not contract: no more reuse in contact
+  // Features are held within this solve only (revisits below), however it ends.
+  m_contact.hold_features(false);
+  struct Release {
+    ContactSet& set;
+    ~Release() { set.hold_features(false); }
+  } release{m_contact};
 
   for (int it = 0;; ++it) {
     auto t0 = clock::now();
@@ -107,19 +138,41 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
     if (it == 0 && may_reuse && ahead && !m_predictor_moved)
       check_ahead_matrix(c0, dt, time_or_factor, external);
 #endif
-    const ContactLinearisation contact =
+    ContactLinearisation contact =
         linearise_contact(c0, dt, time_or_factor, external, !may_reuse);
 
-    const double rn = contact.residual.norm();
-    rep.residuals.push_back(rn);
+    double rn = contact.residual.norm();
     rep.tolerance = st.newton_tolerance * m_force_scale;
+    bool converged = is_converged(it, rn, previous, rep.tolerance, contact.worst_gap, gap_tol);
+    if (converged && m_contact.holds_features() && !held_state_admissible(gap_tol)) {
+      // Detection without the hold finds a node through the surface: Newton goes on from the
+      // same iterate with that detection (the matrix keeps the held curvature).
+      contact = linearise_contact(c0, dt, time_or_factor, external, false);
+      rn = contact.residual.norm();
+      converged = false;
+      ++m_feature_holds_refused;
+    }
+    rep.residuals.push_back(rn);
     rep.active_contacts = contact.active;
     contact_active_or_open = !contact.candidates.empty();
-    if (is_converged(it, rn, previous, rep.tolerance, contact.worst_gap, gap_tol)) {
+    if (converged) {
       rep.converged = true;
       break;
     }
     if (it >= st.newton_max_iterations) break;
+    // Once per solve: a hold whose state detection then refused goes on unheld.
+    if (contact_active_or_open && rep.held_from == 0 && revisits(rep.residuals)) {
+      m_contact.hold_features(true);
+      rep.held_from = it + 1;
+      if (++m_feature_holds <= kHoldNotes)
+        std::fprintf(stderr,
+                     "[solid] note: Newton came back to an earlier residual at %s in iteration "
+                     "%d (%.3e): a cycle of contact choices; the contacts' features are held for "
+                     "the rest of this solve%s\n",
+                     when.c_str(), it, rn,
+                     m_feature_holds == kHoldNotes ? " (further holds only counted in summary.json)"
+                                                   : "");
+    }
     // A first iteration that may reuse had no slot active, and detection activates none.
     FSI_ASSERT(!may_reuse || it > 0 || contact.active == 0);
     if (reused_in_contact && !(rn <= kReuseRatio * previous)) contact_reuse_failed = true;
@@ -160,6 +213,28 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
   return rep;
 }
 
+// A state that converged with held features (hold_features) is taken when detection without the
+// hold finds no node through a surface deeper than kHeldGapSlack of the node's smallest surface
+// edge (the accepted gap, if larger): the two detections differ at the border between features,
+// where a held vertex zone's gap (a joined pair's: up to the zone's radius, detect_self) and an
+// edge's are two models of one contact. Taken, the slots keep the held features the state was
+// solved with (its multipliers act along their normals); refused, they have the new detection
+// and the hold is released.
+bool Solver::held_state_admissible(double gap_tol) {
+  std::vector<ContactSlot> held = m_contact.slots();
+  m_contact.hold_features(false);
+  std::vector<const std::vector<double>*> xs;
+  std::vector<double> reach;
+  for (const auto& b : m_bodies) xs.push_back(&b->x), reach.push_back(b->min_edge);
+  m_contact.detect(xs, reach);
+  for (const auto& s : m_contact.slots()) {
+    const double slack = std::max(gap_tol, kHeldGapSlack * m_bodies[s.slave_body]->min_edge);
+    if (s.gap < -slack) return false;
+  }
+  m_contact.slots() = std::move(held);
+  return true;
+}
+
 // A step with contact that does not converge: which contacts (slave body and node, master body
 // and feature, gap, multiplier), the residual history's tail, and what to change.
 void Solver::fail_contact_not_converged(const StepReport& rep, const std::string& when,
@@ -184,11 +259,15 @@ void Solver::fail_contact_not_converged(const StepReport& rep, const std::string
     history += fmt::format("{}{:.3e}", history.empty() ? "" : ", ", r[k]);
   step_failed(
       "Newton did not converge in {} iterations at {} with contact: residual {:.3e} (the last "
-      "iterations: {}), tolerance {:.3e}, accepted gap {:.3e}; {} active "
+      "iterations: {}), tolerance {:.3e}, accepted gap {:.3e}{}; {} active "
       "and penetrating contacts{}{}\nChange: solid.newton_max_iterations (now {}), "
       "solid.contact_tolerance (now {:g}, relative to the smallest surface edge), or a smaller "
       "[time] dt",
-      rep.iterations, when, r.back(), history, rep.tolerance, gap_tol, shown, list,
+      rep.iterations, when, r.back(), history, rep.tolerance, gap_tol,
+      rep.held_from > 0
+          ? fmt::format("; a cycle: the contacts' features held from iteration {} on", rep.held_from)
+          : "",
+      shown, list,
       shown > kContactsNamed ? fmt::format("\n  ... and {} more", shown - kContactsNamed) : "",
       m_model.settings.newton_max_iterations, m_model.settings.contact_tolerance);
 }

@@ -334,6 +334,12 @@ nlohmann::json SolidProgram::report() const {
   // process started.
   if (m_cfg.model.settings.predictor == Predictor::acceleration)
     j["unpredicted_retries"] = s.unpredicted_retries();
+  // Newton solves that came back to an earlier residual and held their contacts' features
+  // (solid/README.md, Contact), since this process started.
+  if (s.feature_holds() > 0) {
+    j["contact_feature_holds"] = s.feature_holds();
+    j["contact_feature_holds_refused"] = s.feature_holds_refused();
+  }
   j["newton_iterations"] = m_newton_total;
   j["newton_iterations_max"] = m_newton_max;
   j["phases"] = {{"assembly", m_assembly}, {"factorization", m_factor}, {"solve", m_solve}};

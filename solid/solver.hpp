@@ -31,6 +31,7 @@ struct StepReport {
   int active_contacts = 0;
   double assembly_seconds = 0, factor_seconds = 0, solve_seconds = 0;
   int substeps = 1;  // Newmark steps the step took (more than one after a cutback)
+  int held_from = 0;  // the iteration from which a cycle held the contacts' features (0: none)
 };
 
 // A step the solver could not take: Newton did not converge, an element turned inside out, the
@@ -128,6 +129,10 @@ class Solver {
   // Steps (or parts) that failed from the predicted iterate and converged from x^n, since the
   // solver was made (not kept in checkpoints).
   long unpredicted_retries() const { return m_unpredicted_retries; }
+  // Newton solves (steps or their parts) that cycled and held their contacts' features.
+  long feature_holds() const { return m_feature_holds; }
+  // ... whose converged state detection without the hold then refused (newton.cpp).
+  long feature_holds_refused() const { return m_feature_holds_refused; }
   long factorizations() const { return m_factorizations; }
   // Times a contact working set grew within an iteration (solve_contact): a candidate the free
   // step left open was taken through by the constrained one.
@@ -283,6 +288,7 @@ class Solver {
   [[noreturn]] void fail_non_finite_residual(std::pair<int, int> inverted,
                                              const std::string& when) const;
   [[noreturn]] void fail_not_converged(const StepReport& rep, const std::string& when) const;
+  bool held_state_admissible(double gap_tol);
   [[noreturn]] void fail_contact_not_converged(const StepReport& rep, const std::string& when,
                                                double gap_tol) const;
 
@@ -322,6 +328,8 @@ class Solver {
   bool m_predictor_moved = false;  // predict() moved an elastic node off x^n this step
   bool m_predictor_off = false;    // newmark_span(): a failed predicted step taken from x^n
   long m_unpredicted_retries = 0;  // steps that failed predicted and converged from x^n
+  long m_feature_holds = 0;         // Newton solves that held their contacts' features
+  long m_feature_holds_refused = 0;  // ... and whose held state was refused
   LinearSolver m_mass_solver;      // the mass matrix on the free equations (factorize_mass)
   int m_mass_state = 0;            // 0: not factorised yet, 1: factorised, -1: singular
   ContactSet m_contact;

@@ -708,6 +708,71 @@ TEST_CASE("self-contact: a node outside the other's zone keeps its own gap", "[c
   }
 }
 
+// Held features (ContactSet::hold_features, the Newton cycle rule of newton.cpp): a node that
+// slides past its edge's end keeps that edge (the gap to its line, the parameter past 1), and one
+// that leaves a vertex's zone keeps the vertex; released, detection finds the neighbouring edge.
+// Where the feature does not change, holding gives detection's gap and normal.
+TEST_CASE("held contact features: kept while held, detected again once released", "[contact]") {
+  const Mesh mesh = u_mesh();
+  const int n = u_node(mesh, 0.15, 0.6);  // the left arm's inner face
+  const int b = u_node(mesh, 0.35, 1.0);  // the right arm's inner top corner
+  const std::vector<double> reach = {0.05};
+  std::vector<double> x = mesh.x;
+  ContactSet set;
+  setup_self_contact(set, mesh);
+  auto slot = [&]() -> const ContactSlot& { return slot_of(set, n); };
+  // 0.01 in front of the right arm's inner face, facing the edge between y = 0.6 and 0.65.
+  x[2 * n] = 0.34, x[2 * n + 1] = 0.62;
+  set.detect({&x}, reach);
+  REQUIRE(slot().m1 >= 0);
+  const ContactSlot found = slot();
+  set.hold_features(true);
+  set.detect({&x}, reach);
+  CHECK(slot().m0 == found.m0);
+  CHECK(slot().m1 == found.m1);
+  CHECK(slot().gap == Approx(found.gap).margin(1e-15));
+  CHECK(slot().normal[0] == Approx(found.normal[0]));
+  CHECK(slot().normal[1] == Approx(found.normal[1]).margin(1e-15));
+  CHECK(slot().xi == Approx(found.xi));
+  // Slid up past the edge's end: held, the same edge, its line 0.01 away.
+  x[2 * n + 1] = 0.66;
+  set.detect({&x}, reach);
+  CHECK(slot().m0 == found.m0);
+  CHECK(slot().m1 == found.m1);
+  CHECK((slot().xi > 1 || slot().xi < 0));
+  CHECK(slot().gap == Approx(0.01));
+  CHECK(slot().normal[0] == Approx(-1.0));
+  set.hold_features(false);
+  set.detect({&x}, reach);
+  CHECK((slot().m0 != found.m0 || slot().m1 != found.m1));
+  CHECK(slot().gap == Approx(0.01));
+  // In the corner's zone (1 % of an edge, 5e-4; 2 % once there), 2e-5 below its top edge ...
+  x[2 * n] = 0.35 + 3e-4, x[2 * n + 1] = 1.0 - 2e-5;
+  set.detect({&x}, reach);
+  set.detect({&x}, reach);
+  REQUIRE(slot().m0 == b);
+  REQUIRE(slot().m1 == -1);
+  REQUIRE(slot().zone);
+  const ContactSlot at_corner = slot();
+  set.hold_features(true);
+  set.detect({&x}, reach);
+  CHECK(slot().gap == Approx(at_corner.gap).margin(1e-15));
+  CHECK(slot().normal[0] == Approx(at_corner.normal[0]));
+  CHECK(slot().normal[1] == Approx(at_corner.normal[1]));
+  // ... then 1.5e-3 along the top edge, out of the zone: held, still the corner ...
+  x[2 * n] = 0.35 + 1.5e-3;
+  set.detect({&x}, reach);
+  CHECK(slot().m0 == b);
+  CHECK(slot().m1 == -1);
+  CHECK(slot().zone);
+  // ... released, the top edge.
+  set.hold_features(false);
+  set.detect({&x}, reach);
+  CHECK(slot().m1 >= 0);
+  CHECK(slot().normal[1] == Approx(1.0));
+  CHECK(slot().gap == Approx(-2e-5));
+}
+
 // A node behind a feature it did not face at the step's start counts as having gone through it
 // only as deep as it and the feature moved since (twice that): deeper, it is the body's other
 // side (a fold tip squeezed thinner than the smallest edge has its nodes behind the edges of
