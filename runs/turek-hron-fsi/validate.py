@@ -26,6 +26,9 @@ rho_s = 10 rho_f (only the transient differs).
                       164 rows), to t = 8 (about 8 min)
   validate --fsi1-bands-xy FSI1 with bands in x and y around the body (600 x 123, 760 x 152,
                       920 x 184), to t = 8 (about 45 min)
+  validate --fsi2-bands-xy FSI2 with bands in x and y where the bar sweeps, in L2's and L4's
+                      cells (255 x 70, 353 x 99; about 7 min), to set beside the uniform
+                      levels of the default study
   validate --smoothing FSI2 on L2 with coupler.footprint_smoothing 0, 0.5 and 1: the forces'
                       grid-crossing jitter against their bias (about 6 min)
   validate --reuse    keep a run whose folder has a summary.json from the identical scene text
@@ -53,6 +56,8 @@ from metrics import finish, metric, reported  # noqa: E402
 _p = cli.parser(__doc__)
 _p.add_argument("--ci", action="store_true", help="as --short, the frequency against the refined value")
 _p.add_argument("--coarse", action="store_true", help="FSI2 on L1 with coupled iterations")
+_p.add_argument("--fsi2-bands-xy", action="store_true",
+                help="FSI2 with bands in x and y where the bar sweeps")
 _p.add_argument("--dt-limit", action="store_true", help="FSI2 on L2 at growing dt")
 _p.add_argument("--fsi1-level", default="L2", help="FSI1's level (L2)")
 _p.add_argument("--fsi1-only", action="store_true", help="FSI1 alone")
@@ -70,6 +75,11 @@ CI = ARGS.ci
 SHORT = ARGS.short or CI
 REUSE = ARGS.reuse
 COARSE = ARGS.coarse
+BANDS_XY = ARGS.fsi2_bands_xy
+if BANDS_XY and (SHORT or COARSE):
+    _p.error("--fsi2-bands-xy runs its own levels: not with --short, --ci or --coarse")
+# The study's file names: levels{TAG}.md, summary{TAG}.json and fsi2{TAG with _}_histories.png.
+TAG = "-coarse" if COARSE else ("-bands-xy" if BANDS_XY else "")
 HERE = os.path.dirname(os.path.abspath(__file__))
 job.out_dir("turek-hron-fsi")
 OUT = job.nest(ARGS.body_viscosity and f"body-viscosity-{ARGS.body_viscosity}")
@@ -100,8 +110,18 @@ LEVELS = {
     "L3": {"n": 82, "dt": 2.5e-4, "bar": [140, 8]},
     "L4": {"n": 123, "dt": 2.5e-4, "bar": [210, 12]},
 }
+# FSI2 with bands in x and y (--fsi2-bands-xy): L2's and L4's cells (h = 0.41/82, 0.41/123) and
+# bars over x in [0.1, 0.9] (the cylinder, the bar, two bar lengths of its wake) and y in
+# [0.1, 0.31] (the tip sweeps 0.12 ... 0.28), growing outside by the ratio the counts give
+# (1.03 ... 1.05); the bar's faces on grid lines as on the uniform levels.
+for _n, _nx, _ny, _dt, _bar in ((82, 255, 70, 5e-4, [140, 8]), (123, 353, 99, 2.5e-4, [210, 12])):
+    _h = H / _n
+    LEVELS[f"XY{_n}"] = {"n": _ny, "nx": _nx, "lc": _h, "dt": _dt, "bar": _bar,
+                         "x_band": (0.1, 0.9, int(round(0.8 / _h))),
+                         "band": (0.1, 0.31, int(round(0.21 / _h)))}
 
-RUN_LEVELS = ["L2"] if SHORT else (["L1i"] if COARSE else ["L2", "L3", "L4"])
+RUN_LEVELS = (["L2"] if SHORT else ["L1i"] if COARSE else ["XY82", "XY123"] if BANDS_XY
+              else ["L2", "L3", "L4"])
 # The coupled iterations of level L1i (coupler/README.md): about two passes per step.
 ITERATIONS = """
 [coupler.iterations]
@@ -229,8 +249,10 @@ def picture(folder, title, path):
         t = float(f[last].attrs.get("time", float("nan")))
         fig, ax = plt.subplots(figsize=(11, 2.4))
         lim = np.percentile(np.abs(w), 99)
-        ax.imshow(w, origin="lower", extent=[0, L, 0, H], cmap="RdBu_r", vmin=-lim, vmax=lim,
-                  interpolation="nearest", aspect="equal")
+        # Cell values between the cells' faces: uniform and banded grids alike.
+        ax.pcolormesh(f["grid"]["x_face"][:], f["grid"]["y_face"][:], w, cmap="RdBu_r",
+                      vmin=-lim, vmax=lim, shading="flat")
+        ax.set_aspect("equal")
         for name in (k for k in s.keys() if k.startswith("body_")):
             tri = s[name]["triangles"][:]
             x = s[last][name]["position"][:]
@@ -247,18 +269,20 @@ def fsi2(metrics, rows):
     sfig, saxes = plt.subplots(1, 2, figsize=(10, 3.5))
     for level in RUN_LEVELS:
         lv = LEVELS[level]
-        folder, wall, _ = run(f"fsi2-{level}", scene_text("fsi2", level))
+        r_job = job.run(f"fsi2-{level}", scene_text("fsi2", level), reuse=REUSE)
+        folder, wall = r_job.folder, r_job.wall
         hist = histories(folder)
         res = {q: analyse(*hist[q]) for q in hist}
         add_smoothed(hist, res)
         steps = outputs.summary(folder)["steps"]
-        row = {"level": level, "cells": [int(round(L * lv["n"] / H)), lv["n"]], "dt": lv["dt"],
-               "bar_cells": lv["bar"], "steps": steps, "wall_s": wall, "results": res,
-               "errors": {}}
+        row = {"level": level, "cells": [lv.get("nx", int(round(L * lv["n"] / H))), lv["n"]],
+               "dt": lv["dt"], "bar_cells": lv["bar"], "steps": steps, "wall_s": wall,
+               "cpu_s": r_job.cpu, "results": res,
+               "jitter_rms": {q: jitter(hist, q) for q in ("drag", "lift")}, "errors": {}}
         row["errors_refined"] = {}
-        for _, q, _ in QUANTITIES:
+        for q in [q for _, q, _ in QUANTITIES] + ["drag_smoothed", "lift_smoothed"]:
             for key, case in (("errors", "fsi2"), ("errors_refined", "fsi2-refined")):
-                ref = REF[(case, q)]
+                ref = REF[(case, q.replace("_smoothed", ""))]
                 row[key][q] = {"mean": rel(res[q]["mean"], ref["mean"]),
                                "amplitude": rel(res[q]["amplitude"], ref["amplitude"]),
                                "frequency": rel(res[q]["frequency"], ref["frequency"])}
@@ -286,7 +310,7 @@ def fsi2(metrics, rows):
     axes[-1].set_xlabel("t [s]")
     axes[0].set_title("FSI2: point A and forces (dotted: Turek & Hron mean +- amplitude)")
     fig.tight_layout()
-    fig.savefig(os.path.join(OUT, "fsi2_coarse_histories.png" if COARSE else "fsi2_histories.png"), dpi=110)
+    fig.savefig(os.path.join(OUT, f"fsi2{TAG.replace('-', '_')}_histories.png"), dpi=110)
     plt.close(fig)
     for ax, q in zip(saxes, ("uy", "lift")):
         ax.axvline(REF[("fsi2", q)]["frequency"], color="k", ls=":", lw=0.8, label="Turek & Hron 2006")
@@ -297,7 +321,7 @@ def fsi2(metrics, rows):
         ax.set_title(f"FSI2 spectrum of {q} (last 4 s)", fontsize=9)
         ax.legend(fontsize=7)
     sfig.tight_layout()
-    sfig.savefig(os.path.join(OUT, "fsi2_coarse_spectra.png" if COARSE else "fsi2_spectra.png"), dpi=110)
+    sfig.savefig(os.path.join(OUT, f"fsi2{TAG.replace('-', '_')}_spectra.png"), dpi=110)
     plt.close(sfig)
     # Judged on the finest level run, against the 2006 table (the case's reference) and, reported
     # beside it with the same tolerances, against the authors' refined values (reference.csv).
@@ -542,12 +566,13 @@ def fsi1_bands_xy():
 
 
 def write_levels(rows):
-    with open(os.path.join(OUT, "levels-coarse.md" if COARSE else "levels.md"), "w") as f:
+    with open(os.path.join(OUT, f"levels{TAG}.md"), "w") as f:
         f.write("Errors against Turek & Hron (2006); in brackets against the refined FEATFLOW values "
                 "(reference.csv).\n\n")
         f.write("| level | grid | dt | bar | steps | u_y(A) amp | err | u_y f | err | u_x(A) mean | err "
-                "| drag mean +- amp | err (mean, amp) | lift amp | err | 10 ms average: drag, lift amp | wall s |\n")
-        f.write("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+                "| drag mean +- amp | err (mean, amp) | lift amp | err | 10 ms average: drag, lift amp "
+                "| err (drag amp, lift amp) | jitter rms: drag, lift | wall s (CPU s) |\n")
+        f.write("|---" * 19 + "|\n")
         for r in rows:
             res, e, g = r["results"], r["errors"], r["errors_refined"]
 
@@ -564,7 +589,9 @@ def write_levels(rows):
                     f"{res['lift']['amplitude']:.1f} | {pc('lift', 'amplitude')} | "
                     f"{res['drag_smoothed']['mean']:.1f} +- {res['drag_smoothed']['amplitude']:.1f}, "
                     f"{res['lift_smoothed']['amplitude']:.1f} | "
-                    f"{r['wall_s']:.0f} |\n")
+                    f"{pc('drag_smoothed', 'amplitude')}, {pc('lift_smoothed', 'amplitude')} | "
+                    f"{r['jitter_rms']['drag']:.2f}, {r['jitter_rms']['lift']:.2f} | "
+                    f"{r['wall_s']:.0f} ({r['cpu_s'] or float('nan'):.0f}) |\n")
 
 
 def main():
@@ -587,11 +614,11 @@ def main():
     if not ARGS.fsi1_only:
         fsi2(metrics, rows)
         write_levels(rows)
-    if not SHORT and not COARSE:
+    if not SHORT and not COARSE and not BANDS_XY:
         fsi1(metrics, extra)
     extra["levels"] = rows
     finish("turek-hron-fsi", metrics, extra, short=SHORT,
-           name="summary-coarse.json" if COARSE else "summary.json")
+           name=f"summary{TAG}.json")
 
 
 if __name__ == "__main__":
