@@ -122,6 +122,15 @@ double Solver::contact_gap_tolerance() const {
 // becomes R + B^T lambda of the active slots. `with_curvature`: the iteration assembled its
 // matrix, which then takes the active slots' curvature (an iteration that solves with an
 // earlier factor has no matrix of its own to add it to).
+// Every slot's gap and feature at the bodies' current positions, a body's reach its smallest
+// surface edge.
+void Solver::detect_contacts() {
+  std::vector<const std::vector<double>*> xs;
+  std::vector<double> reach;
+  for (const auto& b : m_bodies) xs.push_back(&b->x), reach.push_back(b->min_edge);
+  m_contact.detect(xs, reach);
+}
+
 Solver::ContactLinearisation Solver::linearise_contact(
     double c0, double dt, double time_or_factor, const std::vector<std::vector<double>>* external,
     bool with_curvature) {
@@ -129,13 +138,7 @@ Solver::ContactLinearisation Solver::linearise_contact(
   con.residual = m_residual;
   if (m_contact.empty()) return con;
   auto& slots = m_contact.slots();
-  std::vector<const std::vector<double>*> xs;
-  std::vector<double> reach;
-  for (const auto& b : m_bodies) {
-    xs.push_back(&b->x);
-    reach.push_back(b->min_edge);
-  }
-  m_contact.detect(xs, reach);
+  detect_contacts();
   for (auto& s : slots) {
     if (s.active) {
       con.worst_gap = std::max(con.worst_gap, std::abs(s.gap));

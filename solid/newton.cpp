@@ -223,10 +223,7 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
 bool Solver::held_state_admissible(double gap_tol) {
   std::vector<ContactSlot> held = m_contact.slots();
   m_contact.hold_features(false);
-  std::vector<const std::vector<double>*> xs;
-  std::vector<double> reach;
-  for (const auto& b : m_bodies) xs.push_back(&b->x), reach.push_back(b->min_edge);
-  m_contact.detect(xs, reach);
+  detect_contacts();
   for (const auto& s : m_contact.slots()) {
     const double slack = std::max(gap_tol, kHeldGapSlack * m_bodies[s.slave_body]->min_edge);
     if (s.gap < -slack) return false;

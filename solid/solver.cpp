@@ -70,10 +70,7 @@ Solver::Solver(Model model, LinearSolver::Backend backend)
 // arbitrary impulse. The deepest node of each pair is named.
 void Solver::check_initial_overlap() {
   if (m_contact.empty()) return;
-  std::vector<const std::vector<double>*> xs;
-  std::vector<double> reach;
-  for (const auto& b : m_bodies) xs.push_back(&b->x), reach.push_back(b->min_edge);
-  m_contact.detect(xs, reach);
+  detect_contacts();
   const double tol = contact_gap_tolerance();
   const ContactSlot* worst = nullptr;
   for (const auto& s : m_contact.slots())

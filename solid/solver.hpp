@@ -237,6 +237,7 @@ class Solver {
   // The contact solve of a Newton iteration (contact_solve.cpp).
   struct ContactLinearisation;
   double contact_gap_tolerance() const;
+  void detect_contacts();
   ContactLinearisation linearise_contact(double c0, double dt, double time_or_factor,
                                          const std::vector<std::vector<double>>* external,
                                          bool with_curvature);
