@@ -531,6 +531,14 @@ print("      steps, one run each: factorisations 10 012 -> 300, but Newton 2.17 
 print("      per step (the held factor converges linearly, the look-ahead's exact one")
 print("      quadratically), solid round trip 1.28 -> 1.81 ms, 4.83 -> 5.21 ms per step: the")
 print("      look-ahead runs beside the fluid, off the critical path, so removing it gains nothing")
+print("      (measured again from t = 11, 5 000 steps: factorisations 5 000 -> 8, solves per step 3.0")
+print("      -> 4.4, 5.49 -> 5.60 ms per step)")
+print("  tried, not kept: the two folds' elements assembled side by side on two threads, one per")
+print("      body (the same bits) | -0.1 ms per Newton iteration | h = 0 from its checkpoint at")
+print("      t = 11, 5 000 steps, alternately: every assembly threaded 6.09, 6.10 against 5.49 ms per")
+print("      step (the look-ahead's second thread took the fluid's core: its round trip 1.90 ->")
+print("      2.44 ms); Newton's assemblies only 5.67, 5.77, 6.29 against 6.03, 5.44, 5.96 ms: no")
+print("      core is idle while the solid works (the fluid's work ahead, the waiting programs)")
 PY
 }
 
