@@ -33,7 +33,10 @@ void Solver::add_scene_loads(const Body& B, double t, std::vector<double>& f) co
 //   R = F(t) - Q(x) - c0 M (x - x^n - dt v^n) + (1/2 - beta) / beta (M a)^n + F_c / (2 beta),
 // with Q_a = sum_e A0 F S dN_a/dX (element.hpp) and, when with_matrix,
 //   K_eff = dQ/dx + c0 M  (material + geometric stiffness plus the Newmark mass term).
-// `time_or_factor` is t^(n+1) in dynamics and the load factor in statics.
+// `time_or_factor` is t^(n+1) in dynamics and the load factor in statics. The coupling force
+// enters last (finish_residual): R = R_0 + F_c / (2 beta), R_0 every other term, so that a step's
+// first residual may be the look-ahead's R_0 at the same state plus the step's F_c
+// (take_ahead_residual) with the bits of an assembly.
 std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, double time_or_factor,
                                      const std::vector<std::vector<double>>* external) {
   std::pair<int, int> inverted{-1, -1};
@@ -42,8 +45,7 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
     m_matrix_c0 = c0;
     m_matrix_curved = false;
   }
-  m_residual.setZero();
-  double scale2 = 0, floor2 = 0;
+  m_ahead_residual.valid = false;  // its R_0 is overwritten below
   double* values = m_matrix.valuePtr();
   const bool dynamic = c0 > 0;
   for (auto& bp : m_bodies) {
@@ -52,15 +54,7 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
     const Mesh& mesh = B.spec.mesh;
     std::fill(B.f_ext.begin(), B.f_ext.end(), 0.0);
     add_scene_loads(B, time_or_factor, B.f_ext);
-    if (external && static_cast<int>(external->size()) > B.index && !(*external)[B.index].empty()) {
-      const auto& fe = (*external)[B.index];
-      if (fe.size() != B.f_ext.size())
-        fsi::fail("external forces for body '{}' have {} values, expected {}", B.spec.name,
-                  fe.size(), B.f_ext.size());
-      for (std::size_t d = 0; d < fe.size(); ++d) B.f_cpl[d] = fe[d];
-    } else {
-      std::fill(B.f_cpl.begin(), B.f_cpl.end(), 0.0);
-    }
+    set_coupling_force(B, external);
     std::fill(B.q.begin(), B.q.end(), 0.0);
     const std::vector<double>* iter_w = nullptr;
     if (dynamic && m_iteration_velocity &&
@@ -71,7 +65,7 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
         fsi::fail("iteration velocities for body '{}' have {} values, expected {}",
                   B.spec.name, iter_w->size(), B.u.size());
     }
-    std::vector<double>& r = B.r;
+    std::vector<double>& r = B.r_0;
     // The coupling force is the reaction of the fluid's velocity correction over this step: an
     // impulse F_c dt within the step, like the contact acceleration of the paper's Eq. 13-14
     // (x^(n+1) = ... + dt^2/2 a_c, v^(n+1) = ... + dt a_c). In the trapezoidal residual
@@ -82,15 +76,14 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
     // element-scale modes. Massless dofs (rho_s = rho_f) are quasi-static: F - Q + F_c = 0.
     // With other Newmark parameters (M a)^n enters with (1/2 - beta) / beta and F_c with
     // 1 / (2 beta) (Eq. 13 solved for a^(n+1)); both are exact in the trapezoidal rule (1, 2).
-    const double w_ma = newmark_ma_weight(), w_impulse = newmark_impulse_weight();
-    for (std::size_t d = 0; d < r.size(); ++d)
-      r[d] = B.f_ext[d] + (dynamic ? w_ma * B.ma[d] +
-                                         (B.mass_row[d] > 0 ? w_impulse : 1.0) * B.f_cpl[d]
-                                   : B.f_cpl[d]);
-    std::vector<double>& absq = B.abs_q;  // |element forces| and |K| |u|: scales of R
+    const double w_ma = newmark_ma_weight();
+    for (std::size_t d = 0; d < r.size(); ++d) r[d] = B.f_ext[d] + (dynamic ? w_ma * B.ma[d] : 0.0);
+    std::vector<double>& absq = B.abs_q;  // |element forces|, |inertia| and |K| |u|: scales of R
     std::vector<double>& absm = B.abs_floor;
+    std::vector<double>& absk = B.abs_ku;
     std::fill(absq.begin(), absq.end(), 0.0);
     std::fill(absm.begin(), absm.end(), 0.0);
+    if (with_matrix) std::fill(absk.begin(), absk.end(), 0.0);
     for (int e = 0; e < mesh.num_triangles(); ++e) {
       const auto& t = mesh.triangles[e];
       double fe[6], ke[36];
@@ -186,7 +179,7 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
           double f = 0;
           for (int c = 0; c < 6; ++c)
             f += std::abs(ke[6 * rr + c]) * std::abs(B.u[2 * t[c / 2] + c % 2]);
-          absm[2 * t[rr / 2] + rr % 2] += f;
+          absk[2 * t[rr / 2] + rr % 2] += f;
         }
         const auto& map = B.kmap[e];
         for (int k = 0; k < 36; ++k)
@@ -194,17 +187,47 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
       }
     }
     if (dynamic) add_root_mass(B, dt, with_matrix, r, absm);
-    for (std::size_t d = 0; d < r.size(); ++d) {
-      r[d] -= B.q[d];
+    for (std::size_t d = 0; d < r.size(); ++d) r[d] -= B.q[d];
+  }
+  finish_residual(dynamic, with_matrix);
+  return inverted;
+}
+
+// F_c of body B: the external forces given for it, else zero.
+void Solver::set_coupling_force(Body& B, const std::vector<std::vector<double>>* external) {
+  if (external && static_cast<int>(external->size()) > B.index && !(*external)[B.index].empty()) {
+    const auto& fe = (*external)[B.index];
+    if (fe.size() != B.f_cpl.size())
+      fsi::fail("external forces for body '{}' have {} values, expected {}", B.spec.name,
+                fe.size(), B.f_cpl.size());
+    std::copy(fe.begin(), fe.end(), B.f_cpl.begin());
+  } else {
+    std::fill(B.f_cpl.begin(), B.f_cpl.end(), 0.0);
+  }
+}
+
+// From every body's R_0 (B.r_0) and F_c: r = R_0 + w F_c (w = 1 / (2 beta) on a dof with mass in
+// dynamics, 1 otherwise), the residual on the free equations, its force scale (the norm of the
+// terms that enter it) and its round-off floor (with |K| |u| when the matrix was assembled).
+void Solver::finish_residual(bool dynamic, bool with_matrix) {
+  m_residual.setZero();
+  double scale2 = 0, floor2 = 0;
+  const double w_ma = newmark_ma_weight(), w_impulse = newmark_impulse_weight();
+  for (auto& bp : m_bodies) {
+    Body& B = *bp;
+    if (!B.is_elastic()) continue;
+    for (std::size_t d = 0; d < B.r.size(); ++d) {
+      // The coupling force counts as it enters r: 1 / (2 beta) with mass, once on a massless
+      // dof.
+      const double w_cpl = dynamic && B.mass_row[d] > 0 ? w_impulse : 1.0;
+      B.r[d] = B.r_0[d] + w_cpl * B.f_cpl[d];
       if (B.eq[d] >= 0) {
-        m_residual[B.eq[d]] += r[d];
-        // The coupling force counts as it enters r: 1 / (2 beta) with mass, once on a massless
-        // dof.
-        const double w_cpl = dynamic && B.mass_row[d] > 0 ? w_impulse : 1.0;
-        const double s = std::abs(B.f_ext[d]) + w_cpl * std::abs(B.f_cpl[d]) + absq[d] +
+        m_residual[B.eq[d]] += B.r[d];
+        const double s = std::abs(B.f_ext[d]) + w_cpl * std::abs(B.f_cpl[d]) + B.abs_q[d] +
                          (dynamic ? std::abs(w_ma * B.ma[d]) : 0.0);
+        const double f = s + B.abs_floor[d] + (with_matrix ? B.abs_ku[d] : 0.0);
         scale2 += s * s;
-        floor2 += (s + absm[d]) * (s + absm[d]);
+        floor2 += f * f;
       }
     }
   }
@@ -215,7 +238,47 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
     m_matrix_floor = m_roundoff_scale;
   else
     m_roundoff_scale = std::max(m_roundoff_scale, m_matrix_floor);
-  return inverted;
+}
+
+// The look-ahead's assembly at x^n (factorize_ahead, F_c = 0) kept for the step from x^n: its
+// R_0 (B.r_0) and the state it was assembled at.
+void Solver::keep_ahead_residual(double c0, double dt, double time, std::pair<int, int> inverted) {
+  AheadResidual& a = m_ahead_residual;
+  a.c0 = c0, a.dt = dt, a.time = time, a.inverted = inverted;
+  a.u.resize(m_bodies.size()), a.v.resize(m_bodies.size()), a.ma.resize(m_bodies.size());
+  for (std::size_t b = 0; b < m_bodies.size(); ++b) {
+    const Body& B = *m_bodies[b];
+    if (!B.is_elastic()) continue;
+    a.u[b] = B.u, a.v[b] = B.v_old, a.ma[b] = B.ma;
+  }
+  a.valid = true;
+}
+
+// A step's first residual from the look-ahead's R_0 plus this step's F_c, when R_0 is that of
+// this very assembly: the same c0, dt and time; the iterate, x^n, v^n and (M a)^n the ones it was
+// assembled at (compared value for value: anything that moved the state between them, a
+// restored checkpoint, a set velocity, a predictor, refuses it); no prescribed increment,
+// coupled iterations' velocities or fibers' root masses (terms the look-ahead had not). Then the
+// residual is bit for bit the residual-only assembly's, one element pass less on the step's
+// critical path. Returns false (nothing changed) otherwise.
+bool Solver::take_ahead_residual(double c0, double dt, double time,
+                                 const std::vector<std::vector<double>>* external,
+                                 const std::string& when) {
+  AheadResidual& a = m_ahead_residual;
+  if (!a.valid || a.c0 != c0 || a.dt != dt || a.time != time || m_dirichlet_pending ||
+      m_iteration_velocity || any_root_mass(m_root_mass))
+    return false;
+  for (std::size_t b = 0; b < m_bodies.size(); ++b) {
+    const Body& B = *m_bodies[b];
+    if (B.is_elastic() && (B.u != a.u[b] || B.u_old != a.u[b] || B.v_old != a.v[b] || B.ma != a.ma[b]))
+      return false;
+  }
+  for (auto& bp : m_bodies)
+    if (bp->is_elastic()) set_coupling_force(*bp, external);
+  finish_residual(c0 > 0, false);
+  a.valid = false;
+  if (!m_residual.allFinite()) fail_non_finite_residual(a.inverted, when);
+  return true;
 }
 
 // The fibers' root inertia (the coupler's root_mass: a 2 x 2 block m per node of the edges that

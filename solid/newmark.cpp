@@ -43,8 +43,9 @@ void Solver::factorize_ahead(double dt) {
   if (m_keep_factor && m_factored_valid && m_contact.empty() && m_factored_c0 == newmark_c0(dt))
     return;
   keep_step_start();  // as advance() begins (the residual's inertia reads them)
-  assemble(newmark_c0(dt), dt, true, m_time + dt, nullptr);
+  const auto inverted = assemble(newmark_c0(dt), dt, true, m_time + dt, nullptr);
   if (!m_residual.allFinite()) return;
+  keep_ahead_residual(newmark_c0(dt), dt, m_time + dt, inverted);
   if (contact) {
     if (add_contact_curvature(newmark_c0(dt), dt, m_time + dt, nullptr, false))
       factorize_cached();

@@ -132,7 +132,10 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
         (it > 0 ? plain_factor || !contact_reuse_failed
                 : plain_factor && m_factored_c0 == c0 &&
                       (ahead || (m_keep_allowed && m_keep_factor && m_contact.empty())));
-    assemble_iterate(c0, dt, time_or_factor, external, it > 0, dx, when, !may_reuse);
+    // The first iteration without the matrix takes the look-ahead's residual when it is of this
+    // state (take_ahead_residual), else assembles it.
+    if (!(it == 0 && may_reuse && take_ahead_residual(c0, dt, time_or_factor, external, when)))
+      assemble_iterate(c0, dt, time_or_factor, external, it > 0, dx, when, !may_reuse);
     rep.assembly_seconds += seconds_since(t0);
 #ifndef NDEBUG
     if (it == 0 && may_reuse && ahead && !m_predictor_moved)

@@ -106,12 +106,14 @@ void Solver::setup_body(int index) {
   B.u.assign(2 * nn, 0.0);
   B.abs_q.assign(2 * nn, 0.0);
   B.abs_floor.assign(2 * nn, 0.0);
+  B.abs_ku.assign(2 * nn, 0.0);
   B.v.assign(2 * nn, 0.0);
   B.ma.assign(2 * nn, 0.0);
   B.f_cpl.assign(2 * nn, 0.0);
   B.f_ext.assign(2 * nn, 0.0);
   B.q.assign(2 * nn, 0.0);
   B.r.assign(2 * nn, 0.0);
+  B.r_0.assign(2 * nn, 0.0);
   B.contact.assign(2 * nn, 0.0);
   B.gravity.assign(2 * nn, 0.0);
   B.mass_row.assign(2 * nn, 0.0);

@@ -224,6 +224,12 @@ class Solver {
                                const std::vector<std::vector<double>>* external);
   void add_root_mass(Body& B, double dt, bool with_matrix, std::vector<double>& r,
                      std::vector<double>& absm);
+  void set_coupling_force(Body& B, const std::vector<std::vector<double>>* external);
+  void finish_residual(bool dynamic, bool with_matrix);
+  void keep_ahead_residual(double c0, double dt, double time, std::pair<int, int> inverted);
+  bool take_ahead_residual(double c0, double dt, double time,
+                           const std::vector<std::vector<double>>* external,
+                           const std::string& when);
   void check_initial_overlap();
   // Newton on the step's residual with contact (newton.cpp) and its parts.
   StepReport newton(double c0, double dt, double load_factor,
@@ -326,6 +332,14 @@ class Solver {
   // factorize_ahead() factorised (or found factorised) this step's first matrix: the state the
   // step starts from, its c0, no active contact. Read and cleared by the step's newton().
   bool m_ahead_fresh = false;
+  // The look-ahead's residual without the coupling force and the state it is of
+  // (keep_ahead_residual, take_ahead_residual); any other assembly overwrites it.
+  struct AheadResidual {
+    bool valid = false;
+    double c0 = 0, dt = 0, time = 0;
+    std::pair<int, int> inverted{-1, -1};
+    std::vector<std::vector<double>> u, v, ma;  // per body: x^n - X, v^n, (M a)^n
+  } m_ahead_residual;
   bool m_predictor_moved = false;  // predict() moved an elastic node off x^n this step
   bool m_predictor_off = false;    // newmark_span(): a failed predicted step taken from x^n
   long m_unpredicted_retries = 0;  // steps that failed predicted and converged from x^n

@@ -43,10 +43,12 @@ struct Solver::Body {
   std::vector<double> x;                  // positions X + u, kept in step with u
   std::vector<double> u_old, v_old;       // state at the start of the step
   std::vector<double> f_ext, q, r;        // last assembly: loads, internal force, residual
+  std::vector<double> r_0;                // ... the residual without the coupling force
   std::vector<double> contact;            // contact force on the nodes (physical)
   std::vector<double> det_f;              // per element, last assembly
   std::vector<double> dirichlet_step;     // pending increment of the prescribed dofs
   std::vector<double> abs_q, abs_floor;   // assembly scratch: scales of the residual
+  std::vector<double> abs_ku;             // ... and |K| |u| of the last matrix assembly
   // Loads: constant part (gravity) and per-load nodal coefficients.
   std::vector<double> gravity;
   std::vector<std::vector<std::pair<int, double>>> load_dofs;  // per spec.loads entry
