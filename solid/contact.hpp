@@ -95,10 +95,11 @@ class ContactSet {
                    double reach, const EdgeBins& bins) const;
   void join_vertex_pairs(const std::vector<const std::vector<double>*>& x);
   void hold_slot(ContactSlot& s, const std::vector<const std::vector<double>*>& x) const;
-  // Self-contact geometry at positions pos (detect_self, hold_slot): the sum of the unit normals
-  // of the surface edges at vertex v (its pseudo-normal, not normalised), and the signed distance
-  // from q to the nearer of v's edges (its sign from that edge's normal for a projection inside
-  // it, from n_v at v itself; 0 for a vertex without edges).
+  // Self-contact geometry at positions pos: the sum of the unit normals of the surface edges at
+  // vertex v (its pseudo-normal, not normalised; detect_self, hold_slot), and the signed
+  // distance from q to the nearer of v's edges (its sign from that edge's normal for a
+  // projection inside it, from n_v at v itself; 0 for a vertex without edges), with which
+  // detect_self asks whether a node was in front of a vertex at the step's start.
   static Vec2 pseudo_normal(const Surface& surf, const std::vector<double>& pos, int v);
   static double vertex_gap(const Surface& surf, const std::vector<double>& pos, int v, double qx,
                            double qy, const Vec2& n_v);

@@ -673,9 +673,9 @@ TEST_CASE("self-contact: a node kept in a vertex's zone is not taken for the oth
 
 // The same two corners, a outside b's zone: a is nearest to the vertex b itself, so its normal is
 // the direction from b and its gap the distance (exact), while b is within a's zone (a's edges,
-// stretched across the slot, make it wide) and has a's pseudo-normal and the distance to a's
-// nearer edge. Joined, the pair took one normal and one gap that neither slot had (a creased
-// vocal fold cycled between the two in Newton).
+// stretched across the slot, make it wide) and has a's pseudo-normal n_a and the distance along
+// it, (x_b - x_a) . n_a (the gradient its constraint takes). Joined, the pair took one normal and
+// one gap that neither slot had (a creased vocal fold cycled between the two in Newton).
 TEST_CASE("self-contact: a node outside the other's zone keeps its own gap", "[contact]") {
   const Mesh mesh = u_mesh();
   const int a = u_node(mesh, 0.15, 1.0), b = u_node(mesh, 0.35, 1.0);
@@ -697,13 +697,29 @@ TEST_CASE("self-contact: a node outside the other's zone keeps its own gap", "[c
     CHECK(slot(a).normal[0] == Approx(ox / d));
     CHECK(slot(a).normal[1] == Approx(oy / d));
     CHECK(slot(a).gap == Approx(d));
-    // b at a's vertex, its gap the distance to the edge from a down to below_a (b projects inside
-    // it), outside.
+    // b at a's vertex: a's pseudo-normal (the sum of the unit outward normals of a's two surface
+    // edges, normalised; one of them runs from a down to below_a) and the distance along it,
+    // outside.
     CHECK(slot(b).m0 == a);
     CHECK(slot(b).m1 == -1);
-    const double ex = x[2 * below_a] - x[2 * a], ey = x[2 * below_a + 1] - x[2 * a + 1];
-    const double to_edge = std::abs(-ox * ey - -oy * ex) / std::hypot(ex, ey);
-    CHECK(slot(b).gap == Approx(to_edge));
+    double na[2] = {0, 0};
+    int edges_at_a = 0, edge_to_below = 0;
+    for (const auto& e : mesh.surface) {
+      if (e[0] != a && e[1] != a) continue;
+      ++edges_at_a;
+      edge_to_below += e[0] == below_a || e[1] == below_a;
+      const double ex = x[2 * e[1]] - x[2 * e[0]], ey = x[2 * e[1] + 1] - x[2 * e[0] + 1];
+      const double l = std::hypot(ex, ey);
+      na[0] += ey / l, na[1] += -ex / l;
+    }
+    REQUIRE(edges_at_a == 2);
+    REQUIRE(edge_to_below == 1);
+    const double ln = std::hypot(na[0], na[1]);
+    CHECK(slot(b).normal[0] == Approx(na[0] / ln));
+    CHECK(slot(b).normal[1] == Approx(na[1] / ln));
+    const double along = -(ox * na[0] + oy * na[1]) / ln;  // (x_b - x_a) . n_a
+    CHECK(along > 0);
+    CHECK(slot(b).gap == Approx(along));
     CHECK(std::abs(slot(b).gap - slot(a).gap) > 1e-6);
   }
 }
