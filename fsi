@@ -539,6 +539,13 @@ print("      t = 11, 5 000 steps, alternately: every assembly threaded 6.09, 6.1
 print("      step (the look-ahead's second thread took the fluid's core: its round trip 1.90 ->")
 print("      2.44 ms); Newton's assemblies only 5.67, 5.77, 6.29 against 6.03, 5.44, 5.96 ms: no")
 print("      core is idle while the solid works (the fluid's work ahead, the waiting programs)")
+print("  a step's first residual from the look-ahead's (the coupling force added last; the same bits")
+print("      as assembling it) | one of 4 element passes per step off the solid's critical path,")
+print("      -0.2 ms | h = 0 from t = 11, 2 000 steps, one run each beside another job: solid work on")
+print("      its input 1.87 -> 1.40 ms, assembly 1.06 -> 0.70 ms per step; to t = 12 alone (with the")
+print("      vertex zone's new gap, another trajectory): solid work on its input 1.76 -> 1.60 ms,")
+print("      assembly 0.94 -> 0.78 ms per step, but 1 321 -> 1 358 s (5.50 -> 5.66 ms per step: the")
+print("      messages 0.58 -> 0.86 ms and the footprint 1.48 -> 1.61 ms on that day)")
 PY
 }
 

@@ -78,7 +78,9 @@ std::pair<int, int> Solver::assemble(double c0, double dt, bool with_matrix, dou
     // 1 / (2 beta) (Eq. 13 solved for a^(n+1)); both are exact in the trapezoidal rule (1, 2).
     const double w_ma = newmark_ma_weight();
     for (std::size_t d = 0; d < r.size(); ++d) r[d] = B.f_ext[d] + (dynamic ? w_ma * B.ma[d] : 0.0);
-    std::vector<double>& absq = B.abs_q;  // |element forces|, |inertia| and |K| |u|: scales of R
+    // Scales of R: |element forces| (absq); the inertia's and root masses' round-off floor
+    // (absm); |K| |u| with the matrix (absk).
+    std::vector<double>& absq = B.abs_q;
     std::vector<double>& absm = B.abs_floor;
     std::vector<double>& absk = B.abs_ku;
     std::fill(absq.begin(), absq.end(), 0.0);
@@ -270,7 +272,8 @@ bool Solver::take_ahead_residual(double c0, double dt, double time,
     return false;
   for (std::size_t b = 0; b < m_bodies.size(); ++b) {
     const Body& B = *m_bodies[b];
-    if (B.is_elastic() && (B.u != a.u[b] || B.u_old != a.u[b] || B.v_old != a.v[b] || B.ma != a.ma[b]))
+    if (B.is_elastic() &&
+        (B.u != a.u[b] || B.u_old != a.u[b] || B.v_old != a.v[b] || B.ma != a.ma[b]))
       return false;
   }
   for (auto& bp : m_bodies)

@@ -292,8 +292,8 @@ void ContactSet::bin_edges(const Surface& surf, const std::vector<double>& x, do
 // pressed onto each other): slot a has the vertex b as its feature with b's pseudo-normal n_b,
 // slot b the vertex a with n_a. They are one point contact, but as two constraints with two
 // normals both hold only where b - a is normal to n_a and to n_b, that is a = b: the contact
-// glued the nodes, Newton converged on it slowly (the normals are not the gaps' gradients in
-// the vertex zone) and, at Δt = 5e-5 in the vocal folds' flow, not within 30 iterations. Both
+// glued the nodes, Newton converged on it slowly (the normals were not the gaps' gradients in
+// the vertex zone then) and, at Δt = 5e-5 in the vocal folds' flow, not within 30 iterations. Both
 // slots now take one normal, n = (n_b - n_a) / |n_b - n_a| (for a: b's side outward; for b:
 // -n), and the gap (a - b) . n: the same constraint twice, which the complementarity solve
 // handles as any two slots on one contact (it keeps one), and the nodes may slide along each
@@ -361,6 +361,11 @@ Vec2 ContactSet::pseudo_normal(const Surface& surf, const std::vector<double>& p
   return nv;
 }
 
+double ContactSet::zone_gap(const std::vector<double>& pos, int v, const Vec2& n_v, double qx,
+                            double qy) {
+  return (qx - pos[2 * v]) * n_v[0] + (qy - pos[2 * v + 1]) * n_v[1];
+}
+
 double ContactSet::vertex_gap(const Surface& surf, const std::vector<double>& pos, int v,
                               double qx, double qy, const Vec2& n_v) {
   double nearest = std::numeric_limits<double>::max(), g = 0;
@@ -402,7 +407,7 @@ void ContactSet::hold_slot(ContactSlot& s, const std::vector<const std::vector<d
   const double ln = std::hypot(nv[0], nv[1]);
   if (s.zone && ln > 1e-6) {
     s.normal = {nv[0] / ln, nv[1] / ln};
-    s.gap = (px - xm[2 * v]) * s.normal[0] + (py - xm[2 * v + 1]) * s.normal[1];
+    s.gap = zone_gap(xm, v, s.normal, px, py);
     return;
   }
   s.zone = false;  // (a zone whose vertex's edges now fold back onto each other: detect_self)
@@ -548,7 +553,9 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
 //     faced was the vertex's neighbour, and the constraint threw the surface by that much in
 //     one iteration (Newton diverged).
 // - Within a vertex's zone (kSelfVertexZone) the vertex is the feature, with its pseudo-normal
-//   as the normal, from whichever of its edges it is found; the gap stays the distance.
+//   as the normal, from whichever of its edges it is found, and the distance along it as the
+//   gap; whether the node is behind the feature (the body's other side, a crossing) is still
+//   decided on its distance to the nearer edge.
 // Only features within kSelfSearch reaches are looked for (a box test first).
 // The closest remaining feature wins, with detect_slot's rules: ties prefer the edge whose
 // interior holds the projection, and the last edge extended by kKeepEdge is kept.
@@ -574,7 +581,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     if (start.empty()) return true;
     const double floor = -std::max(kKeepEdge * reach, m_gap_tol);
     const double sx = start[2 * s.slave_node], sy = start[2 * s.slave_node + 1];
-    if (vertex) {  // as the gap is taken at a vertex: to the nearer of its two edges
+    if (vertex) {  // the side of the surface at a vertex: the nearer of its two edges'
       const int v = xi <= 0 ? e[0] : e[1];
       return vertex_gap(surf, start, v, sx, sy, pseudo_normal(surf, start, v)) >= floor;
     }
@@ -664,9 +671,13 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     // edge on one side of v, were placed by its constraint where the edge on the other side was
     // the closer, and switched between the two at every iteration. The gap is the distance along
     // n_v, g = (p - v) . n_v, whose gradient the constraint takes (B: n_v and -n_v; n_v's own
-    // change with v's neighbours is left out, a term of the order of |p - v|, a hundredth of an
-    // edge): Newton converges as at an edge. At the zone's border g differs from the distance
-    // to the nearer edge by at most the zone's radius. The distance itself (the gap before) has
+    // change with the motion of v and its neighbours is left out, a term of the order of
+    // |p - v|, a hundredth of an edge): Newton converges as at an edge. It is the gap to the
+    // plane through v normal to n_v: it differs from the distance to the nearer edge by up to
+    // |p - v| |n_v - n_e| (n_e that edge's normal; within 1.5 zone radii), and a node on a convex
+    // corner's edge is behind that plane. So whether the node is behind the feature (the
+    // body's other side, a crossing, below) is decided on the distance to the nearer edge,
+    // `depth`, as before this gap. The distance itself (the gap before) has
     // the nearer edge's normal as its gradient, up to half the kink away from n_v: Newton
     // converged linearly, by 1 - cos of that angle per iteration, and at a corner folded to a
     // crease (a vocal fold's root pressed onto the wall, h = 0.01, t = 11.40: n_v 80 degrees
@@ -683,9 +694,11 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     const Vec2 nv = zone >= 0 ? pseudo_normal(surf, x, zone) : Vec2{0, 0};
     const double ln = std::hypot(nv[0], nv[1]);
     const bool in_zone = zone >= 0 && ln > 1e-6;
+    double depth = 0;  // the signed distance to the surface there; g but in a zone
     if (in_zone) {  // (a vertex whose edges fold back onto each other has no pseudo-normal)
       n = {nv[0] / ln, nv[1] / ln};
-      g = (px - x[2 * zone]) * n[0] + (py - x[2 * zone + 1]) * n[1];
+      g = zone_gap(x, zone, n, px, py);
+      depth = vertex_gap(surf, x, zone, px, py, n);
       vertex = true;
       xi = zone == e[0] ? 0 : 1;
     } else if (vertex) {
@@ -731,13 +744,14 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     // 1.46e-5 against bounds of 0.91e-5 and 3.4e-5 in alternate iterations, so the pair was
     // joined in one iteration and not in the next, and Newton cycled through every cutback.
     const bool kept_zone = in_zone && s.zone && s.m1 < 0 && s.m0 == zone;
-    if (g < -cross && !kept_zone) continue;
+    if (!in_zone) depth = g;
+    if (depth < -cross && !kept_zone) continue;
     auto offer = [&](Feature& f) {
       if (rank < f.rank * (1 - kClosestTie) || (rank <= f.rank * (1 + kClosestTie) && interior))
         f = {rank, k, xi, g, n, vertex, in_zone};
     };
     offer(closest);
-    if (guard_edge && g < 0 && in_front_at_start(e, xi, vertex, start)) offer(crossed);
+    if (guard_edge && depth < 0 && in_front_at_start(e, xi, vertex, start)) offer(crossed);
   }
   // Behind what it faced (or touched) by no more than the node can have crossed since the
   // step's start: that is the contact (the nearest such), even when the body's other side is

@@ -98,11 +98,15 @@ class ContactSet {
   // Self-contact geometry at positions pos: the sum of the unit normals of the surface edges at
   // vertex v (its pseudo-normal, not normalised; detect_self, hold_slot), and the signed
   // distance from q to the nearer of v's edges (its sign from that edge's normal for a
-  // projection inside it, from n_v at v itself; 0 for a vertex without edges), with which
-  // detect_self asks whether a node was in front of a vertex at the step's start.
+  // projection inside it, from n_v at v itself; 0 for a vertex without edges), on which
+  // detect_self decides whether a node is (or was at the step's start) behind a vertex.
   static Vec2 pseudo_normal(const Surface& surf, const std::vector<double>& pos, int v);
   static double vertex_gap(const Surface& surf, const std::vector<double>& pos, int v, double qx,
                            double qy, const Vec2& n_v);
+  // A vertex zone's gap (detect_self, hold_slot): the distance from the vertex v along its unit
+  // pseudo-normal n_v, (q - v) . n_v.
+  static double zone_gap(const std::vector<double>& pos, int v, const Vec2& n_v, double qx,
+                         double qy);
   std::vector<Surface> m_surfaces;
   std::vector<ContactPlane> m_planes;
   std::vector<ContactSlot> m_slots;

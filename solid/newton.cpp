@@ -59,7 +59,8 @@ constexpr double kCycleMatch = 1e-3;
 constexpr std::size_t kCyclePeriod = 4;
 // A state converged with held features may have a node this far (relative to its smallest
 // surface edge) through a surface by detection without the hold: twice the vertex zone's radius
-// (contact.cpp, kSelfVertexZone), the most a joined pair's gap is off the distance.
+// (contact.cpp, kSelfVertexZone), the most a joined pair's gap is off the distance (a zone's
+// gap, to the plane through its vertex, is off it by up to 1.4 radii of that vertex's zone).
 constexpr double kHeldGapSlack = 0.02;
 // Holds noted on stderr; later ones are only counted (contact_feature_holds).
 constexpr long kHoldNotes = 10;
