@@ -677,12 +677,9 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     // |p - v| |n_v - n_e| (n_e that edge's normal; within 1.5 zone radii), and a node on a convex
     // corner's edge is behind that plane. So whether the node is behind the feature (the
     // body's other side, a crossing, below) is decided on the distance to the nearer edge,
-    // `depth`, as before this gap. The distance itself (the gap before) has
-    // the nearer edge's normal as its gradient, up to half the kink away from n_v: Newton
-    // converged linearly, by 1 - cos of that angle per iteration, and at a corner folded to a
-    // crease (a vocal fold's root pressed onto the wall, h = 0.01, t = 11.40: n_v 80 degrees
-    // from the edge's normal) by 18 % per iteration, so that no cutback reached the accepted
-    // gap.
+    // `depth`. That distance as the gap has the nearer edge's normal as its gradient, up to half
+    // the kink away from n_v, and Newton would converge by only 1 - cos of that angle per
+    // iteration (solid/README.md, Self-contact).
     int zone = -1;
     for (int v : e) {
       const auto& ve = surf.vertex_edges[v];
@@ -694,11 +691,9 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     const Vec2 nv = zone >= 0 ? pseudo_normal(surf, x, zone) : Vec2{0, 0};
     const double ln = std::hypot(nv[0], nv[1]);
     const bool in_zone = zone >= 0 && ln > 1e-6;
-    double depth = 0;  // the signed distance to the surface there; g but in a zone
     if (in_zone) {  // (a vertex whose edges fold back onto each other has no pseudo-normal)
       n = {nv[0] / ln, nv[1] / ln};
       g = zone_gap(x, zone, n, px, py);
-      depth = vertex_gap(surf, x, zone, px, py, n);
       vertex = true;
       xi = zone == e[0] ? 0 : 1;
     } else if (vertex) {
@@ -744,7 +739,8 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     // 1.46e-5 against bounds of 0.91e-5 and 3.4e-5 in alternate iterations, so the pair was
     // joined in one iteration and not in the next, and Newton cycled through every cutback.
     const bool kept_zone = in_zone && s.zone && s.m1 < 0 && s.m0 == zone;
-    if (!in_zone) depth = g;
+    // The signed distance to the surface there: g, but in a zone.
+    const double depth = in_zone ? vertex_gap(surf, x, zone, px, py, n) : g;
     if (depth < -cross && !kept_zone) continue;
     auto offer = [&](Feature& f) {
       if (rank < f.rank * (1 - kClosestTie) || (rank <= f.rank * (1 + kClosestTie) && interior))
