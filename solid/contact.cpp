@@ -26,10 +26,10 @@ constexpr double kSelfNear = 3;
 // are not looked for; its slot is then far (gap +infinity), and it has no front for the next
 // step. A candidate needs a gap below one reach.
 constexpr double kSelfSearch = 4;
-// Self-contact: a node within this fraction of the shorter edge at a vertex (twice that while
-// the vertex is already its feature as a zone) touches the vertex, with the vertex's pseudo-normal as the
-// gap's gradient (detect_self).
-constexpr double kSelfVertexZone = 0.01;
+// A node within this fraction of the shorter edge at a vertex of a surface (twice that while the
+// vertex is already its feature as a zone) touches the vertex, with the vertex's pseudo-normal
+// as the gap's gradient (detect_self, and detect_slot between two bodies).
+constexpr double kVertexZone = 0.01;
 // Self-contact: a node behind a feature is the body's other side unless it is within this many
 // times its motion since the step's start, relative to the feature's point under it (plus the
 // accepted gap, at least kKeepEdge reaches; at most one reach, except at the guarded features:
@@ -103,6 +103,9 @@ void ContactSet::setup(const std::vector<const Mesh*>& meshes, const std::vector
     for (const auto& e : m->surface) s.nodes.insert(s.nodes.end(), e.begin(), e.end());
     std::sort(s.nodes.begin(), s.nodes.end());
     s.nodes.erase(std::unique(s.nodes.begin(), s.nodes.end()), s.nodes.end());
+    s.vertex_edges.assign(m->num_nodes(), {});
+    for (std::size_t k = 0; k < m->surface.size(); ++k)
+      for (int v : m->surface[k]) s.vertex_edges[v].push_back(static_cast<int>(k));
     m_surfaces.push_back(std::move(s));
   }
   auto add = [&](int slave, int master) {
@@ -134,13 +137,13 @@ void ContactSet::setup(const std::vector<const Mesh*>& meshes, const std::vector
       }
     }
   m_front.assign(m_slots.size(), {-1, -1});
-  // Self-contact: each body's slot per surface node (for the pairs of nodes at each other's
-  // vertex, detect()).
-  m_self_slot.assign(meshes.size(), {});
+  // Each pair's slot per slave node (for the pairs of nodes at each other's vertex, detect()).
+  const std::size_t nb = meshes.size();
+  m_node_slot.assign(nb * nb, {});
   for (std::size_t k = 0; k < m_slots.size(); ++k) {
     const ContactSlot& c = m_slots[k];
-    if (c.master_body != c.slave_body) continue;
-    auto& index = m_self_slot[c.slave_body];
+    if (c.master_body < 0) continue;
+    auto& index = m_node_slot[c.slave_body * nb + c.master_body];
     if (index.empty()) index.assign(meshes[c.slave_body]->num_nodes(), -1);
     index[c.slave_node] = static_cast<int>(k);
   }
@@ -152,9 +155,6 @@ void ContactSet::setup_self(Surface& s) const {
   auto length = [&](const std::array<int, 2>& e) {
     return std::hypot(X[2 * e[1]] - X[2 * e[0]], X[2 * e[1] + 1] - X[2 * e[0] + 1]);
   };
-  s.vertex_edges.assign(m.num_nodes(), {});
-  for (std::size_t k = 0; k < m.surface.size(); ++k)
-    for (int v : m.surface[k]) s.vertex_edges[v].push_back(static_cast<int>(k));
   // Node n does not look at edge k when they are within kSelfNear times the longer of n's
   // surface edges and k in the reference configuration (local lengths: a graded mesh's long
   // edges do not widen the small edges' neighbourhoods).
@@ -202,8 +202,8 @@ void ContactSet::detect(const std::vector<const std::vector<double>*>& x,
     }
   }
   m_self_bins.resize(m_surfaces.size());
-  for (std::size_t b = 0; b < m_self_slot.size(); ++b)
-    if (!m_self_slot[b].empty())
+  for (std::size_t b = 0; b < m_surfaces.size(); ++b)
+    if (!m_node_slot[b * m_surfaces.size() + b].empty())
       bin_edges(m_surfaces[b], *x[b], kSelfSearch * reach[b], m_self_bins[b]);
   m_reach.assign(reach.begin(), reach.end());
   for (std::size_t k = 0; k < m_slots.size(); ++k) {
@@ -288,46 +288,46 @@ void ContactSet::bin_edges(const Surface& surf, const std::vector<double>& x, do
   bins.start[0] = 0;
 }
 
-// Two nodes a and b of one surface, each at the other's vertex (a curled fold's two shoulders
-// pressed onto each other): slot a has the vertex b as its feature with b's pseudo-normal n_b,
-// slot b the vertex a with n_a. They are one point contact, but as two constraints with two
-// normals both hold only where b - a is normal to n_a and to n_b, that is a = b: the contact
-// glued the nodes, Newton converged on it slowly (the normals were not the gaps' gradients in
-// the vertex zone then) and, at Δt = 5e-5 in the vocal folds' flow, not within 30 iterations. Both
-// slots now take one normal, n = (n_b - n_a) / |n_b - n_a| (for a: b's side outward; for b:
-// -n), and the gap (a - b) . n: the same constraint twice, which the complementarity solve
-// handles as any two slots on one contact (it keeps one), and the nodes may slide along each
-// other. Only when both are in the other's zone: a node outside it, nearest to the vertex
-// itself, has the direction from the vertex as its normal and its distance as its gap (that
-// gradient is exact). Joined with a node in the zone that is behind its edges, the pair took
-// the gap +1.7e-4 where one slot had -5.4e-5 and the other +2.1e-4 (a fold's surface creased,
-// two nodes five apart pressed together: vocal folds, finer cover); the join came and went
-// as the outer node crossed the Voronoi border of the vertex, and Newton cycled between the
-// two gaps through every step cutback.
+// Two surface nodes a and b, each at the other's vertex: of one surface (a curled fold's two
+// shoulders pressed onto each other) or of two bodies in a two-way pair (two folds' corners
+// meeting). Slot a has the vertex b as its feature with b's pseudo-normal n_b, slot b the
+// vertex a with n_a. They are one point contact, but as two constraints with two normals both
+// hold only where b - a is normal to n_a and to n_b, that is a = b: the contact glued the nodes,
+// Newton converged on it slowly (the normals were not the gaps' gradients in the vertex zone
+// then) and, at Δt = 5e-5 in the vocal folds' flow, not within 30 iterations. Both slots now
+// take one normal, n = (n_b - n_a) / |n_b - n_a| (for a: b's side outward; for b: -n), and the
+// gap (a - b) . n: the same constraint twice, which the complementarity solve handles as any two
+// slots on one contact (it keeps one), and the nodes may slide along each other. Only when both
+// are in the other's zone: a node outside it, nearest to the vertex itself, has the direction
+// from the vertex as its normal and its distance as its gap (that gradient is exact). Joined
+// with a node in the zone that is behind its edges, the pair took the gap +1.7e-4 where one slot
+// had -5.4e-5 and the other +2.1e-4 (a fold's surface creased, two nodes five apart pressed
+// together: vocal folds, finer cover); the join came and went as the outer node crossed the
+// Voronoi border of the vertex, and Newton cycled between the two gaps through every step
+// cutback.
 void ContactSet::join_vertex_pairs(const std::vector<const std::vector<double>*>& x) {
-  for (std::size_t b = 0; b < m_self_slot.size(); ++b) {
-    const auto& index = m_self_slot[b];
-    if (index.empty()) continue;
-    const std::vector<double>& xb = *x[b];
-    for (int ka : index) {
-      if (ka < 0) continue;
-      ContactSlot& sa = m_slots[ka];
-      if (sa.m0 < 0 || sa.m1 >= 0) continue;  // a's feature is not a vertex
-      const int kb = index[sa.m0];
-      if (kb <= ka) continue;  // each pair once
-      ContactSlot& sb = m_slots[kb];
-      if (sb.m0 != sa.slave_node || sb.m1 >= 0) continue;
-      if (!sa.zone || !sb.zone) continue;  // one nearest to the vertex itself (above)
-      Vec2 n{sa.normal[0] - sb.normal[0], sa.normal[1] - sb.normal[1]};
-      const double ln = std::hypot(n[0], n[1]);
-      if (!(ln > 1e-6)) continue;  // normals that cancel: no common direction
-      n = {n[0] / ln, n[1] / ln};
-      const int a = sa.slave_node, v = sb.slave_node;
-      const double g = (xb[2 * a] - xb[2 * v]) * n[0] + (xb[2 * a + 1] - xb[2 * v + 1]) * n[1];
-      sa.normal = n;
-      sb.normal = {-n[0], -n[1]};
-      sa.gap = sb.gap = g;
-    }
+  const std::size_t nb = m_surfaces.size();
+  for (std::size_t ka = 0; ka < m_slots.size(); ++ka) {
+    ContactSlot& sa = m_slots[ka];
+    if (sa.master_body < 0 || sa.m0 < 0 || sa.m1 >= 0 || !sa.zone) continue;  // no zone vertex
+    const auto& index = m_node_slot[sa.master_body * nb + sa.slave_body];
+    if (index.empty()) continue;  // no slots the other way
+    const int kb = index[sa.m0];
+    if (kb <= static_cast<int>(ka)) continue;  // each pair once
+    ContactSlot& sb = m_slots[kb];
+    if (sb.m0 != sa.slave_node || sb.m1 >= 0) continue;
+    if (!sb.zone) continue;  // b nearest to the vertex a itself (above)
+    Vec2 n{sa.normal[0] - sb.normal[0], sa.normal[1] - sb.normal[1]};
+    const double ln = std::hypot(n[0], n[1]);
+    if (!(ln > 1e-6)) continue;  // normals that cancel: no common direction
+    n = {n[0] / ln, n[1] / ln};
+    const std::vector<double>& xa = *x[sa.slave_body];
+    const std::vector<double>& xv = *x[sa.master_body];
+    const int a = sa.slave_node, v = sb.slave_node;
+    const double g = (xa[2 * a] - xv[2 * v]) * n[0] + (xa[2 * a + 1] - xv[2 * v + 1]) * n[1];
+    sa.normal = n;
+    sb.normal = {-n[0], -n[1]};
+    sa.gap = sb.gap = g;
   }
 }
 
@@ -386,10 +386,9 @@ double ContactSet::vertex_gap(const Surface& surf, const std::vector<double>& po
 
 // A held slot (hold_features): its feature's gap and normal at the positions x, as detection
 // takes them for that feature, without looking for another. An edge is the line through it
-// (the parameter not clamped: the node may slide past its end while held); a vertex zone
-// (self-contact) the pseudo-normal with the distance along it; another vertex
-// the direction from it, on the side detection finds (ray casting between two bodies, the
-// pseudo-normal on the body's own surface).
+// (the parameter not clamped: the node may slide past its end while held); a vertex zone the
+// pseudo-normal with the distance along it; another vertex the direction from it, on the side
+// detection finds (ray casting between two bodies, the pseudo-normal on the body's own surface).
 void ContactSet::hold_slot(ContactSlot& s, const std::vector<const std::vector<double>*>& x) const {
   const std::vector<double>& xs = *x[s.slave_body];
   const std::vector<double>& xm = *x[s.master_body];
@@ -403,14 +402,14 @@ void ContactSet::hold_slot(ContactSlot& s, const std::vector<const std::vector<d
   }
   const int v = s.m0;
   const bool self = s.master_body == s.slave_body;
-  const Vec2 nv = self ? pseudo_normal(surf, xm, v) : Vec2{0, 0};
+  const Vec2 nv = pseudo_normal(surf, xm, v);
   const double ln = std::hypot(nv[0], nv[1]);
   if (s.zone && ln > 1e-6) {
     s.normal = {nv[0] / ln, nv[1] / ln};
     s.gap = zone_gap(xm, v, s.normal, px, py);
     return;
   }
-  s.zone = false;  // (a zone whose vertex's edges now fold back onto each other: detect_self)
+  s.zone = false;  // (a zone whose vertex's edges now fold back onto each other)
   const double qx = px - xm[2 * v], qy = py - xm[2 * v + 1];
   const double d = std::hypot(qx, qy);
   if (d == 0) {  // on the vertex: no direction from it; the last normal stays
@@ -439,6 +438,8 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
   if (s.master_body == s.slave_body)
     return detect_self(s, m_front[&s - m_slots.data()], *x[s.slave_body], reach,
                        m_self_bins[s.slave_body]);
+  const bool was_zone = s.zone && s.m0 >= 0 && s.m1 < 0;  // the last detection's zone vertex
+  s.zone = false;
   const auto& box = boxes[s.master_body];
   const double dx = std::max({box[0] - px, 0.0, px - box[2]});
   const double dy = std::max({box[1] - py, 0.0, py - box[3]});
@@ -484,6 +485,43 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
       best_xi = xi;
     }
   }
+  // A vertex's zone: nearest to the vertex v itself (beyond both its edges' ends) and within
+  // kVertexZone of v's shorter edge, or within twice that while v is the slot's zone already
+  // (from whichever side). There the normal is v's unit pseudo-normal n_v and the gap
+  // (p - v) . n_v, as on a body's own surface (detect_self), and two nodes each in the other's
+  // zone are one contact (join_vertex_pairs). Before the zone, the normal at a vertex was the
+  // direction from it, exact but turning as fast as the node moves round v: two folds' corner
+  // nodes pressed onto each other (vocal folds, h = 0.01, t = 2.752) were 4e-6 and 1e-9 apart in
+  // alternate Newton iterations, the normal swung by 90 degrees between them, and Newton cycled
+  // through every cutback, with the features held too. In v's wedge the two gaps differ by
+  // |p - v| (1 - n . n_v), a fraction of a zone's radius. The zone's slot keeps it while within
+  // the doubled radius, also where the node is nearer to an edge's interior or coincides with v
+  // (its projection then ties between the edges): the normal does not switch back and forth
+  // between n_v and an edge's at the wedge's border. A node facing an edge, its end included,
+  // does not enter a zone: at a punch's corner on a flat base the pseudo-normal tilted the
+  // contact force (solid/README.md, Contact).
+  const Surface& surf = m_surfaces[s.master_body];
+  auto take_zone = [&](int v, double widen) {
+    const auto& ve = surf.vertex_edges[v];
+    if (ve.size() != 2) return false;
+    auto length = [&](int k) {
+      const auto& ek = mesh.surface[k];
+      return std::hypot(xm[2 * ek[1]] - xm[2 * ek[0]], xm[2 * ek[1] + 1] - xm[2 * ek[0] + 1]);
+    };
+    const double r = widen * kVertexZone * std::min(length(ve[0]), length(ve[1]));
+    const Vec2 nv = pseudo_normal(surf, xm, v);
+    const double ln = std::hypot(nv[0], nv[1]);
+    // (a vertex whose edges fold back onto each other has no pseudo-normal)
+    if (!(std::hypot(px - xm[2 * v], py - xm[2 * v + 1]) <= r && ln > 1e-6)) return false;
+    s.m0 = v;
+    s.m1 = -1;
+    s.xi = 0;
+    s.normal = {nv[0] / ln, nv[1] / ln};
+    s.gap = zone_gap(xm, v, s.normal, px, py);
+    s.zone = true;
+    return true;
+  };
+  if (was_zone && take_zone(s.m0, 2)) return;
   // A node at a vertex of the master (coincident nodes of mirrored meshes that touch, a node on
   // a kink of the surface) is as close to both edges that share it; which one wins above is
   // decided by round-off and flips from one Newton iteration to the next, and with it the normal
@@ -510,6 +548,7 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
   const bool vertex = best_xi <= 0 || best_xi >= 1;
   if (vertex && dist > kVertexDistance * le) {
     const int v = best_xi <= 0 ? e[0] : e[1];
+    if (take_zone(v, 1)) return;
     const double sign = inside_surface(mesh, xm, px, py) ? -1.0 : 1.0;
     s.m0 = v;
     s.m1 = -1;
@@ -552,7 +591,7 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
 //     by its pseudo-normal, a vocal fold's node was taken as through it once the feature it
 //     faced was the vertex's neighbour, and the constraint threw the surface by that much in
 //     one iteration (Newton diverged).
-// - Within a vertex's zone (kSelfVertexZone) the vertex is the feature, with its pseudo-normal
+// - Within a vertex's zone (kVertexZone) the vertex is the feature, with its pseudo-normal
 //   as the normal, from whichever of its edges it is found, and the distance along it as the
 //   gap; whether the node is behind the feature (the body's other side, a crossing) is still
 //   decided on its distance to the nearer edge.
@@ -685,7 +724,7 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
       const auto& ve = surf.vertex_edges[v];
       if (ve.size() != 2) continue;
       const double shortest = std::min(edge_length(ve[0]), edge_length(ve[1]));
-      const double r = kSelfVertexZone * shortest * (s.zone && s.m0 == v ? 2 : 1);
+      const double r = kVertexZone * shortest * (s.zone && s.m0 == v ? 2 : 1);
       if (std::hypot(px - x[2 * v], py - x[2 * v + 1]) <= r) zone = v;
     }
     const Vec2 nv = zone >= 0 ? pseudo_normal(surf, x, zone) : Vec2{0, 0};

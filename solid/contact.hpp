@@ -28,8 +28,8 @@ struct ContactSlot {
   int m0 = -1, m1 = -1;
   double xi = 0;
   Vec2 normal{0, 0};
-  // Self-contact: the feature is a vertex whose zone holds the node, the normal its
-  // pseudo-normal (detect_self); only such slots are joined in pairs (join_vertex_pairs).
+  // The feature is a vertex whose zone holds the node, the normal its pseudo-normal
+  // (detect_self, detect_slot); only such slots are joined in pairs (join_vertex_pairs).
   bool zone = false;
   // Active-set state carried across Newton iterations and steps.
   bool active = false;
@@ -71,9 +71,9 @@ class ContactSet {
   struct Surface {
     const Mesh* mesh = nullptr;
     std::vector<int> nodes;  // nodes on the surface
-    // Self-contact only (empty otherwise), indexed by mesh node: the surface edges a node never
-    // touches (those near it in the reference configuration; sorted), and the surface edges
-    // that meet at the node (for the sign of a gap to a vertex).
+    // Indexed by mesh node: the surface edges a node never touches (those near it in the
+    // reference configuration; sorted; self-contact only, empty otherwise), and the surface
+    // edges that meet at the node (a vertex's pseudo-normal, the sign of a gap to it).
     std::vector<std::vector<int>> self_near;
     std::vector<std::vector<int>> vertex_edges;
   };
@@ -95,16 +95,16 @@ class ContactSet {
                    double reach, const EdgeBins& bins) const;
   void join_vertex_pairs(const std::vector<const std::vector<double>*>& x);
   void hold_slot(ContactSlot& s, const std::vector<const std::vector<double>*>& x) const;
-  // Self-contact geometry at positions pos: the sum of the unit normals of the surface edges at
-  // vertex v (its pseudo-normal, not normalised; detect_self, hold_slot), and the signed
-  // distance from q to the nearer of v's edges (its sign from that edge's normal for a
+  // A surface's geometry at positions pos: the sum of the unit normals of the surface edges at
+  // vertex v (its pseudo-normal, not normalised; detect_self, detect_slot, hold_slot), and the
+  // signed distance from q to the nearer of v's edges (its sign from that edge's normal for a
   // projection inside it, from n_v at v itself; 0 for a vertex without edges), on which
   // detect_self decides whether a node is (or was at the step's start) behind a vertex.
   static Vec2 pseudo_normal(const Surface& surf, const std::vector<double>& pos, int v);
   static double vertex_gap(const Surface& surf, const std::vector<double>& pos, int v, double qx,
                            double qy, const Vec2& n_v);
-  // A vertex zone's gap (detect_self, hold_slot): the distance from the vertex v along its unit
-  // pseudo-normal n_v, (q - v) . n_v.
+  // A vertex zone's gap (detect_self, detect_slot, hold_slot): the distance from the vertex v
+  // along its unit pseudo-normal n_v, (q - v) . n_v.
   static double zone_gap(const std::vector<double>& pos, int v, const Vec2& n_v, double qx,
                          double qy);
   std::vector<Surface> m_surfaces;
@@ -116,7 +116,9 @@ class ContactSet {
   bool m_hold = false;                        // hold_features
   std::vector<char> m_held;                   // per slot, while m_hold: its feature is kept
   std::vector<double> m_reach;                // per body, of the last detect()
-  std::vector<std::vector<int>> m_self_slot;  // per body, per node: its self-contact slot or -1
+  // Per (slave body, master body), slave * bodies + master: the slot of each slave node, or -1
+  // (empty when the pair has no slots).
+  std::vector<std::vector<int>> m_node_slot;
   std::vector<EdgeBins> m_self_bins;          // per body (self-contact), detect
 };
 

@@ -59,7 +59,7 @@ constexpr double kCycleMatch = 1e-3;
 constexpr std::size_t kCyclePeriod = 4;
 // A state converged with held features may have a node this far (relative to its smallest
 // surface edge) through a surface by detection without the hold: twice the vertex zone's radius
-// (contact.cpp, kSelfVertexZone), the most a joined pair's gap is off the distance (a zone's
+// (contact.cpp, kVertexZone), the most a joined pair's gap is off the distance (a zone's
 // gap, to the plane through its vertex, is off it by up to 1.4 radii of that vertex's zone).
 constexpr double kHeldGapSlack = 0.02;
 // Holds noted on stderr; later ones are only counted (contact_feature_holds).
@@ -218,10 +218,11 @@ StepReport Solver::newton(double c0, double dt, double time_or_factor,
 }
 
 // A state that converged with held features (hold_features) is taken when detection without the
-// hold finds no node through a surface deeper than kHeldGapSlack of the node's smallest surface
-// edge (the accepted gap, if larger): the two detections differ at the border between features,
-// where a held vertex zone's gap (a joined pair's: up to the zone's radius, detect_self) and an
-// edge's are two models of one contact. Taken, the slots keep the held features the state was
+// hold finds no node through a surface deeper than kHeldGapSlack of the smallest surface edge of
+// the node's body or of the body it touches, the larger (the accepted gap, if larger still): the
+// two detections differ at the border between features, where a held vertex zone's gap (a joined
+// pair's: up to the zone's radius, a fraction of the master's edge; detect_self, detect_slot) and
+// an edge's are two models of one contact. Taken, the slots keep the held features the state was
 // solved with (its multipliers act along their normals); refused, they have the new detection
 // and the hold is released.
 bool Solver::held_state_admissible(double gap_tol) {
@@ -229,7 +230,9 @@ bool Solver::held_state_admissible(double gap_tol) {
   m_contact.hold_features(false);
   detect_contacts();
   for (const auto& s : m_contact.slots()) {
-    const double slack = std::max(gap_tol, kHeldGapSlack * m_bodies[s.slave_body]->min_edge);
+    double edge = m_bodies[s.slave_body]->min_edge;
+    if (s.master_body >= 0) edge = std::max(edge, m_bodies[s.master_body]->min_edge);
+    const double slack = std::max(gap_tol, kHeldGapSlack * edge);
     if (s.gap < -slack) return false;
   }
   m_contact.slots() = std::move(held);

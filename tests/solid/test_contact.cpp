@@ -636,6 +636,118 @@ TEST_CASE("self-contact: two nodes at each other's vertex are one contact",
 }
 
 
+// Two blocks meeting corner to corner: the lower one's top right corner a and the upper one's
+// bottom left corner b, both at (0.4, 0.5) in the reference (edges of 0.05: zones of 5e-4). A
+// node nearest to the other body's corner itself and within its zone takes that corner's
+// pseudo-normal as its normal and the distance along it as its gap, so the normal does not turn
+// with the direction from the corner (two vocal folds' corner nodes 4e-6 and 1e-9 apart in
+// alternate Newton iterations swung the normal by 90 degrees, and Newton cycled); two nodes each
+// in the other's zone are one contact, one normal and one gap in both slots. Out of the zone, the
+// direction from the corner and the distance; facing an edge, the edge.
+TEST_CASE("two bodies: corner nodes at each other's vertex are one contact", "[contact]") {
+  const Mesh lower = rectangle_mesh(0, 0, 0.4, 0.5, 8, 10, Diagonals::right);
+  const Mesh upper = rectangle_mesh(0.4, 0.5, 0.4, 0.5, 8, 10, Diagonals::right);
+  auto node_at = [](const Mesh& m, double px, double py) {
+    for (int n = 0; n < m.num_nodes(); ++n)
+      if (std::hypot(m.x[2 * n] - px, m.x[2 * n + 1] - py) < 1e-12) return n;
+    FAIL("no node at (" << px << ", " << py << ")");
+    return -1;
+  };
+  const int a = node_at(lower, 0.4, 0.5), b = node_at(upper, 0.4, 0.5);
+  for (bool two_way : {true, false}) {
+    INFO("two-way " << two_way);
+    ContactSet set;
+    ContactPair p;
+    p.slave = 0;
+    p.master = 1;
+    p.two_way = two_way;
+    set.setup({&lower, &upper}, {BodyKind::elastic, BodyKind::elastic}, {p}, {});
+    auto slot = [&](int body, int n) -> const ContactSlot& {
+      for (const auto& s : set.slots())
+        if (s.slave_body == body && s.slave_node == n) return s;
+      FAIL("no slot for body " << body << " node " << n);
+      return set.slots().front();
+    };
+    std::vector<double> xl = lower.x, xu = upper.x;
+    const std::vector<double> reach = {0.05, 0.05};
+    const double r = std::sqrt(0.5);  // b's pseudo-normal is (-r, -r), a's (r, r)
+    // a below and left of b, 1e-9, 1e-7 and 1e-4 away in three directions of b's quadrant:
+    // always b's pseudo-normal and the distance along it.
+    for (double d : {1e-9, 1e-7, 1e-4})
+      for (double angle : {190.0, 225.0, 260.0}) {
+        const double t = angle * M_PI / 180;
+        xl[2 * a] = 0.4 + d * std::cos(t), xl[2 * a + 1] = 0.5 + d * std::sin(t);
+        set.detect({&xl, &xu}, reach);
+        INFO("a at b + " << d << " at " << angle << " degrees");
+        const ContactSlot& sa = slot(0, a);
+        CHECK(sa.m0 == b);
+        CHECK(sa.m1 == -1);
+        CHECK(sa.zone);
+        // Joined, the normal lies between b's and -a's pseudo-normals, and a's turns as a's
+        // edges do: by about d over an edge.
+        const double turn = two_way ? 2 * d / 0.05 : 0;
+        CHECK(sa.normal[0] == Approx(-r).margin(turn));
+        CHECK(sa.normal[1] == Approx(-r).margin(turn));
+        const double g = (xl[2 * a] - xu[2 * b]) * sa.normal[0] +
+                         (xl[2 * a + 1] - xu[2 * b + 1]) * sa.normal[1];
+        CHECK(sa.gap == g);
+        CHECK(sa.gap > 0);
+        if (two_way) {  // b is in a's zone too: one contact
+          const ContactSlot& sb = slot(1, b);
+          CHECK(sb.m0 == a);
+          CHECK(sb.m1 == -1);
+          CHECK(sb.normal[0] == -sa.normal[0]);
+          CHECK(sb.normal[1] == -sa.normal[1]);
+          CHECK(sb.gap == sa.gap);
+        }
+      }
+    // Once in the zone, a keeps it within twice its radius from any side: 7e-4 away, under b's
+    // bottom edge (its interior nearer), on b itself. Held, the zone stays when a leaves it.
+    auto place = [&](double dx, double dy) {
+      xl[2 * a] = 0.4 + dx, xl[2 * a + 1] = 0.5 + dy;
+      set.detect({&xl, &xu}, reach);
+    };
+    for (const auto& o : {std::array<double, 2>{-5e-4, -5e-4}, {2e-4, -1e-5}, {0.0, 0.0}}) {
+      place(-1e-4, -1e-4);
+      place(o[0], o[1]);
+      INFO("a at b + (" << o[0] << ", " << o[1] << ")");
+      CHECK(slot(0, a).m0 == b);
+      CHECK(slot(0, a).m1 == -1);
+      CHECK(slot(0, a).zone);
+      CHECK(slot(0, a).normal[1] < -0.5);
+    }
+    place(-5e-4, -5e-4);  // fresh (the last detection's zone left: no zone since), not in it
+    place(-3e-3, -3e-3);
+    place(-5e-4, -5e-4);
+    CHECK_FALSE(slot(0, a).zone);
+    CHECK(slot(0, a).gap == Approx(std::sqrt(2) * 5e-4));
+    place(-1e-4, -1e-4);
+    REQUIRE(slot(0, a).zone);
+    set.hold_features(true);
+    place(-3e-3, -1e-3);
+    CHECK(slot(0, a).m0 == b);
+    CHECK(slot(0, a).zone);
+    if (!two_way) CHECK(slot(0, a).normal[0] == Approx(-r));
+    CHECK(slot(0, a).gap == Approx(-3e-3 * slot(0, a).normal[0] - 1e-3 * slot(0, a).normal[1]));
+    set.hold_features(false);
+    // 2e-3 away (out of the zone): the direction from b and the distance.
+    xl[2 * a] = 0.4 - 2e-3, xl[2 * a + 1] = 0.5 - 1e-3;
+    set.detect({&xl, &xu}, reach);
+    CHECK(slot(0, a).m0 == b);
+    CHECK(slot(0, a).m1 == -1);
+    CHECK_FALSE(slot(0, a).zone);
+    CHECK(slot(0, a).gap == Approx(std::hypot(2e-3, 1e-3)));
+    CHECK(slot(0, a).normal[0] == Approx(-2 / std::sqrt(5.0)));
+    // Under b's bottom edge, 1e-4 along it and 1e-5 below: that edge.
+    xl[2 * a] = 0.4 + 1e-4, xl[2 * a + 1] = 0.5 - 1e-5;
+    set.detect({&xl, &xu}, reach);
+    CHECK(slot(0, a).m1 >= 0);
+    CHECK_FALSE(slot(0, a).zone);
+    CHECK(slot(0, a).normal[1] == Approx(-1.0));
+    CHECK(slot(0, a).gap == Approx(1e-5));
+  }
+}
+
 // A node in a vertex's zone and behind it by more than twice its motion since the step's start
 // (here: it has not moved) is at that vertex, not at the body's other side, when the last
 // detection had it there: the crossing bound drops a fresh find only. (A creased vocal fold's
