@@ -380,6 +380,20 @@ Config read_config(const fsi::SceneTable& s, double fluid_density) {
     p.two_way = p.slave != p.master && t.boolean("two_way", true);
     // A rigid body only ever provides the surface.
     if (c.model.bodies[p.slave].kind == BodyKind::rigid) std::swap(p.slave, p.master);
+    // Each direction (slave against master) once: a repeated one would have two slots per node,
+    // each with its own multiplier on one constraint, and only one of them could be joined with
+    // its partner at a vertex (ContactSet::join_vertex_pairs).
+    auto covers = [](const ContactPair& q, int slave, int master) {
+      return (q.slave == slave && q.master == master) ||
+             (q.two_way && q.slave == master && q.master == slave);
+    };
+    for (const auto& q : c.model.contacts)
+      if (covers(q, p.slave, p.master) || (p.two_way && covers(q, p.master, p.slave)))
+        t.fail("bodies",
+               fmt::format("repeats the contact of \"{}\" with \"{}\" that an earlier "
+                           "[[solid.contact]] has (one table per pair of bodies: two_way = true, "
+                           "the default, takes both directions)",
+                           names[0], names[1]));
     t.finish();
     c.model.contacts.push_back(p);
   }

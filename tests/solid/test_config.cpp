@@ -260,6 +260,28 @@ TEST_CASE("unknown keys and wrong choices", "[config][input]") {
                              "[[solid.contact]]\nbodies = [\"block\", \"block\"]\ntwo_way = true\n"),
                     Catch::Contains("solid.contact[0].two_way") &&
                         Catch::Contains("self-contact") && Catch::Contains("self_two_way.toml"));
+  // A pair named twice (in either order, when the first takes both directions): an error.
+  std::string lid = block;
+  lid.replace(lid.find("\"block\""), 7, "\"lid\"");
+  const std::string pair = "[[solid.contact]]\nbodies = [\"block\", \"lid\"]\n";
+  CHECK_THROWS_WITH(
+      read("twice.toml", "[solid]\n" + block + lid + pair +
+                             "[[solid.contact]]\nbodies = [\"lid\", \"block\"]\n"),
+      Catch::Contains("solid.contact[1].bodies") && Catch::Contains("repeats the contact") &&
+          Catch::Contains("twice.toml"));
+  CHECK_THROWS_WITH(read("self_twice.toml", "[solid]\n" + block +
+                                                "[[solid.contact]]\nbodies = [\"block\", \"block\"]\n"
+                                                "[[solid.contact]]\nbodies = [\"block\", \"block\"]\n"),
+                    Catch::Contains("solid.contact[1].bodies") &&
+                        Catch::Contains("repeats the contact"));
+  // One way each, opposite directions: both directions once, as one two-way pair.
+  const Config both = read("both.toml", "[solid]\n" + block + lid +
+                                            "[[solid.contact]]\nbodies = [\"block\", \"lid\"]\n"
+                                            "two_way = false\n"
+                                            "[[solid.contact]]\nbodies = [\"lid\", \"block\"]\n"
+                                            "two_way = false\n");
+  CHECK(both.model.contacts.size() == 2);
+  CHECK(read("pair.toml", "[solid]\n" + block + lid + pair).model.contacts.size() == 1);
   CHECK_THROWS_WITH(
       read("probe.toml",
            "[solid]\n" + block + "[[solid.body.probe]]\nname = \"P\"\npoint = [3, 3]\n"),
