@@ -361,6 +361,16 @@ Vec2 ContactSet::pseudo_normal(const Surface& surf, const std::vector<double>& p
   return nv;
 }
 
+double ContactSet::zone_radius(const Surface& surf, const std::vector<double>& pos, int v) {
+  double shortest = std::numeric_limits<double>::max();
+  for (int j : surf.vertex_edges[v]) {
+    const auto& e = surf.mesh->surface[j];
+    shortest = std::min(shortest, std::hypot(pos[2 * e[1]] - pos[2 * e[0]],
+                                             pos[2 * e[1] + 1] - pos[2 * e[0] + 1]));
+  }
+  return kVertexZone * shortest;
+}
+
 double ContactSet::zone_gap(const std::vector<double>& pos, int v, const Vec2& n_v, double qx,
                             double qy) {
   return (qx - pos[2 * v]) * n_v[0] + (qy - pos[2 * v + 1]) * n_v[1];
@@ -402,7 +412,8 @@ void ContactSet::hold_slot(ContactSlot& s, const std::vector<const std::vector<d
   }
   const int v = s.m0;
   const bool self = s.master_body == s.slave_body;
-  const Vec2 nv = pseudo_normal(surf, xm, v);
+  // The pseudo-normal: the zone's normal, and on the body's own surface the side of the vertex.
+  const Vec2 nv = s.zone || self ? pseudo_normal(surf, xm, v) : Vec2{0, 0};
   const double ln = std::hypot(nv[0], nv[1]);
   if (s.zone && ln > 1e-6) {
     s.normal = {nv[0] / ln, nv[1] / ln};
@@ -502,13 +513,8 @@ void ContactSet::detect_slot(ContactSlot& s, const std::vector<const std::vector
   // contact force (solid/README.md, Contact).
   const Surface& surf = m_surfaces[s.master_body];
   auto take_zone = [&](int v, double widen) {
-    const auto& ve = surf.vertex_edges[v];
-    if (ve.size() != 2) return false;
-    auto length = [&](int k) {
-      const auto& ek = mesh.surface[k];
-      return std::hypot(xm[2 * ek[1]] - xm[2 * ek[0]], xm[2 * ek[1] + 1] - xm[2 * ek[0] + 1]);
-    };
-    const double r = widen * kVertexZone * std::min(length(ve[0]), length(ve[1]));
+    if (surf.vertex_edges[v].size() != 2) return false;
+    const double r = zone_radius(surf, xm, v) * widen;
     const Vec2 nv = pseudo_normal(surf, xm, v);
     const double ln = std::hypot(nv[0], nv[1]);
     // (a vertex whose edges fold back onto each other has no pseudo-normal)
@@ -604,10 +610,6 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
   const Surface& surf = m_surfaces[s.slave_body];
   const Mesh& mesh = *surf.mesh;
   const double px = x[2 * s.slave_node], py = x[2 * s.slave_node + 1];
-  auto edge_length = [&](int k) {
-    const auto& e = mesh.surface[k];
-    return std::hypot(x[2 * e[1]] - x[2 * e[0]], x[2 * e[1] + 1] - x[2 * e[0] + 1]);
-  };
   // Whether the node was in front of (or on) the feature at the step's start (`start`, the
   // body's positions then; none given: yes): the feature's point under it then (the vertex, or
   // the edge's point at the same xi), its normal then (the pseudo-normal, or the edge's), and
@@ -721,10 +723,8 @@ void ContactSet::detect_self(ContactSlot& s, const std::array<int, 2>& front,
     // iteration (solid/README.md, Self-contact).
     int zone = -1;
     for (int v : e) {
-      const auto& ve = surf.vertex_edges[v];
-      if (ve.size() != 2) continue;
-      const double shortest = std::min(edge_length(ve[0]), edge_length(ve[1]));
-      const double r = kVertexZone * shortest * (s.zone && s.m0 == v ? 2 : 1);
+      if (surf.vertex_edges[v].size() != 2) continue;
+      const double r = zone_radius(surf, x, v) * (s.zone && s.m0 == v ? 2 : 1);
       if (std::hypot(px - x[2 * v], py - x[2 * v + 1]) <= r) zone = v;
     }
     const Vec2 nv = zone >= 0 ? pseudo_normal(surf, x, zone) : Vec2{0, 0};

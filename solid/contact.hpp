@@ -103,6 +103,9 @@ class ContactSet {
   static Vec2 pseudo_normal(const Surface& surf, const std::vector<double>& pos, int v);
   static double vertex_gap(const Surface& surf, const std::vector<double>& pos, int v, double qx,
                            double qy, const Vec2& n_v);
+  // The radius of vertex v's zone: kVertexZone times the shorter of its edges at pos (a vertex
+  // with two edges; detect_self, detect_slot).
+  static double zone_radius(const Surface& surf, const std::vector<double>& pos, int v);
   // A vertex zone's gap (detect_self, detect_slot, hold_slot): the distance from the vertex v
   // along its unit pseudo-normal n_v, (q - v) . n_v.
   static double zone_gap(const std::vector<double>& pos, int v, const Vec2& n_v, double qx,
