@@ -58,6 +58,9 @@ void SolidProgram::save(fsi::H5File& h5) const {
                                                      m_newton_max, m_cut_steps});
   h5.write("solid/t_end", std::vector<double>{m_rt.settings().t_end});
   h5.write("solid/contact_entries", m_solver->contact_entries());
+  // The energy balance's works and the coupling forces of the last step (its f^n).
+  h5.write("solid/work", std::vector<double>{m_coupling_work, m_contact_work});
+  fsi::write_vectors(h5, "solid/external_used", m_external_used);
   const KeptFactor k = m_solver->kept_factor();
   h5.write("solid/kept_factor", k.values);
   h5.write("solid/kept_factor_info", std::vector<double>{k.c0, k.matrix_floor});
@@ -93,6 +96,15 @@ void SolidProgram::load(const fsi::H5File& h5) {
   m_newton_total = counts.at(3), m_newton_max = counts.at(4);
   m_cut_steps = counts.size() > 5 ? counts[5] : 0;  // (checkpoints before step_cutbacks: none)
   m_solver->restore_state(s);
+  // (Checkpoints written before the energy balance: the works count from the resumed time, and
+  // the first step takes its f^n as zero.)
+  m_coupling_work = m_contact_work = 0;
+  m_external_used.clear();
+  if (h5.exists("solid/work")) {
+    const auto w = h5.read_doubles("solid/work");
+    m_coupling_work = w.at(0), m_contact_work = w.at(1);
+    m_external_used = fsi::read_vectors(h5, "solid/external_used");
+  }
   if (h5.exists("solid/contact_entries"))
     m_solver->restore_contact_entries(h5.read_int64s("solid/contact_entries"));
   KeptFactor k;

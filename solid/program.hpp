@@ -36,6 +36,7 @@ class SolidProgram : public fsi::SolidPort {
  private:
   void write_modes();
   void write_fields(long step, double t);
+  void add_step_work();
 
   fsi::Runtime& m_rt;
   Config m_cfg;
@@ -46,6 +47,11 @@ class SolidProgram : public fsi::SolidPort {
   std::vector<MeshPoint> m_probe_points;
   std::vector<double> m_row;
   std::vector<std::vector<double>> m_external;
+  // The energy balance (solid_history.csv): the work done on the elastic bodies since t = 0 by
+  // the coupling forces and by contact, and what a step needs for it: the positions and both
+  // forces at the step's start (t^n) and the coupling forces of the last step taken.
+  double m_coupling_work = 0, m_contact_work = 0, m_work_start[2] = {0, 0};
+  std::vector<std::vector<double>> m_x_n, m_contact_n, m_external_n, m_external_used;
   Modes m_modes;
   StepReport m_last;
   StepState m_start;  // the state the current step started from (coupled iterations)
