@@ -88,6 +88,12 @@ struct Config {
   // keep it, which changes nothing inside them (body_viscosity.cpp);
   // "kelvin-voigt": the fluid's viscosity everywhere, bodies are Kelvin-Voigt with μ_s = μ_f.
   bool bodies_inviscid = true;
+  // fluid.body_divergence = "zero" (the default, the paper's): the fluid divergence-free
+  // everywhere, inside bodies too; "solid": the projection holds the fluid inside an elastic
+  // body at the body's own divergence (its volume change), so that a compressible body is not
+  // held incompressible by the fluid it carries (projection.cpp, dilating_cells; for bodies much
+  // heavier than the fluid: fluid/README.md).
+  bool bodies_dilate = false;
   // fluid.forcing_time tau >= 0: the immersed forcing's relaxation time (forcing.cpp). A face of
   // volume fraction alpha is blended by beta = alpha dt / ((1 - alpha) tau + alpha dt), so a
   // steady flow's slip in a cut face is (1 - alpha)/alpha tau R whatever dt; < 0 (not given):

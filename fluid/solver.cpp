@@ -415,6 +415,7 @@ void Solver::correct(double dt, const CouplingIn& in, CouplingOut& out) {
   {
     const PhaseTimer t(m_time.predictor, m_time.cpu);
     immersed_forcing(dt, in, out);
+    dilating_cells(in);
   }
   project(dt, m_t + dt);
   {

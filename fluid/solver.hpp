@@ -117,6 +117,12 @@ class Solver {
   const Field& u() const { return m_u; }
   const Field& v() const { return m_v; }
   const Field& p() const { return m_p; }
+  // body_divergence = "solid": the divergence the last projection left in each cell on purpose
+  // (φ D u~ inside elastic bodies, projection.cpp; zero elsewhere), for the health check.
+  // Null before any.
+  const Field* allowed_divergence() const {
+    return m_div_allowed.a.empty() ? nullptr : &m_div_allowed;
+  }
   // Make the current velocity discretely divergence-free (boundary values at the current time).
   void project_initial();
   // Checkpoints (checkpoint.cpp): the state a step starts from, between steps: u, v, p with their
@@ -164,6 +170,7 @@ class Solver {
   void remove_body_viscosity(double dt, const CouplingIn& in);  // body_viscosity.cpp
   // dt, and the time whose boundary pressures p^(n+1) takes (t^n + dt; t^n for project_initial).
   void project(double dt, double t_new);                                    // projection.cpp
+  void dilating_cells(const CouplingIn& in);                                 // projection.cpp
   // The face pressures at time t into m_face_p (pressure sides; per row; solver.cpp).
   void face_pressure(double t);
   void keep_predictor();                                                     // solver.cpp
@@ -245,6 +252,19 @@ class Solver {
   bool m_body_faces = true;
   bool m_un_kept = false;
   std::array<std::vector<double>, 2> m_force_sum;  // end_substeps: the solid force's sums
+  // body_divergence = "solid" (projection.cpp): the step's cells inside elastic bodies with
+  // their φ (the smallest elastic α of the cell's four faces) and D ū_s, the faces' elastic α
+  // and ū_s while the list is made (zero otherwise), per-row sums, and the divergence the
+  // projection left in those cells.
+  struct DilatingCell {
+    int i, j;
+    double phi, div;  // φ_c and D ū_s of the cell
+  };
+  std::vector<DilatingCell> m_dilating, m_dilated;
+  bool m_dilate_step = false;  // dilating_cells() found elastic faces on some rank
+  std::array<Field, 2> m_dil_alpha, m_dil_us;
+  std::vector<double> m_dil_rows;
+  Field m_div_allowed;
   Timings m_time;
 };
 

@@ -21,6 +21,14 @@ def body_viscosity(p, what):
                         "kelvin-voigt), outputs under OUT/.../body-viscosity-X")
 
 
+def body_divergence(p, what):
+    """The --body-divergence option of a case whose runs WHAT ([fluid] body_divergence written
+    into its scenes; not given: the fluid's default)."""
+    p.add_argument("--body-divergence", choices=("solid", "zero"), default=None,
+                   help=f"[fluid] body_divergence of {what} (default: not written, the fluid's "
+                        "own), outputs under OUT/.../body-divergence-X")
+
+
 def implicit_forcing(p, what):
     """The --implicit-forcing option of a case whose runs WHAT with Crank-Nicolson ([fluid]
     implicit_forcing written into its scenes; not given: the fluid's default, "increment")."""

@@ -108,6 +108,7 @@ P.add_argument("--newmark-gamma", type=float, metavar="G", default=None,
                help="the solid's Newmark gamma instead of the scene's 0.55 (solid.newmark_gamma; "
                     "beta = (G + 1/2)^2 / 4; 0.5: the paper's trapezoidal rule)")
 cli.body_viscosity(P, "the coupled runs")
+cli.body_divergence(P, "the coupled runs")
 P.add_argument("--checkpoint-interval", type=cli.positive, metavar="T", default=None,
                help="the coupled runs write a checkpoint every T")
 ARGS = P.parse_args()
@@ -122,7 +123,7 @@ OUT = TOP = job.out_dir("vocal-folds")
 # and `./fsi report` look for a case's summary.
 DEFAULT_SETUP = all(getattr(ARGS, k) == P.get_default(k) for k in (
     "material", "dt", "wall_planes", "substeps", "cover_size", "convection", "predictor",
-    "newmark_gamma", "body_viscosity"))
+    "newmark_gamma", "body_viscosity", "body_divergence"))
 OUT = job.nest(None if ARGS.material == "saint-venant-kirchhoff" else ARGS.material,
                None if ARGS.dt is None else f"dt-{ARGS.dt:g}",
                "planes" if ARGS.wall_planes else None,
@@ -131,7 +132,8 @@ OUT = job.nest(None if ARGS.material == "saint-venant-kirchhoff" else ARGS.mater
                "upwind3" if UPWIND3 else None,
                "predictor" if ARGS.predictor else None,
                None if ARGS.newmark_gamma is None else f"gamma-{ARGS.newmark_gamma:g}",
-               None if ARGS.body_viscosity is None else f"body-viscosity-{ARGS.body_viscosity}")
+               None if ARGS.body_viscosity is None else f"body-viscosity-{ARGS.body_viscosity}",
+               None if ARGS.body_divergence is None else f"body-divergence-{ARGS.body_divergence}")
 # The substeps' CFL number: AB2 with third-order upwind fluxes is stable to about 0.58 (1D).
 SUBSTEPS_CFL = 0.5 if UPWIND3 else 0.8
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -210,6 +212,9 @@ bodies = ["upper"]
     if ARGS.body_viscosity is not None and fluid:
         text = text.replace("viscosity = 6.666666666666667e-4",
                             f'viscosity = 6.666666666666667e-4\nbody_viscosity = "{ARGS.body_viscosity}"')
+    if ARGS.body_divergence is not None and fluid:
+        text = text.replace("viscosity = 6.666666666666667e-4",
+                            f'viscosity = 6.666666666666667e-4\nbody_divergence = "{ARGS.body_divergence}"')
     return text
 
 
