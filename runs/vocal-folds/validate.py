@@ -42,6 +42,8 @@ runs are in OUT/neo-hookean/planes/substeps-4/upwind3.
 --body-viscosity kelvin-voigt: the folds carry the fluid's viscous stress ([fluid]
   body_viscosity; the runs of README.md before the fluid's default became "none" did), outputs
   under OUT/.../body-viscosity-kelvin-voigt.
+--body-divergence solid: the fluid in the folds takes their divergence ([fluid] body_divergence;
+  README.md, "What stops the pressure inlet"), outputs under OUT/.../body-divergence-solid.
 --checkpoint-interval T: the coupled runs write a checkpoint every T (`./fsi run SCENE --restart
   RUN` resumes one; the outputs are unchanged).
 With no option (`./fsi validate vocal-folds`): --modes, --short and --sweep."""
