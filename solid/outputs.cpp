@@ -43,6 +43,11 @@ double Solver::strain_energy() const {
   return w;
 }
 
+bool Solver::massless(int b, std::size_t d) const {
+  const Body& B = *m_bodies[b];
+  return B.is_elastic() && d < B.mass_row.size() && !(B.mass_row[d] > 0);
+}
+
 double Solver::load_potential() const {
   double p = 0;
   for (const auto& bp : m_bodies) {

@@ -248,15 +248,19 @@ void SolidProgram::advance(const fsi::proto::StepBegin& sb, const fsi::proto::So
 }
 
 // The work done on the elastic bodies over the step just taken (or taken again), from the
-// step's start: for a force f held at t^n and t^(n+1),
-//   W += ½ (f^n + f^(n+1)) · (x^(n+1) − x^n),
-// summed over the nodes, for the coupling forces (f^n those of the last step taken, zero before
-// the first) and for the contact forces (the multipliers' nodal forces). With the trapezoidal
-// rule (γ = ½, β = ¼) on a linear elastic body this is the step's change of kinetic plus strain
-// energy exactly: M (v^(n+1) − v^n) = ½ Δt (f^n + f^(n+1) − K (x^n + x^(n+1))) and
-// x^(n+1) − x^n = ½ Δt (v^n + v^(n+1)). So kinetic + strain + load potential − the two works is
-// what the time stepping gained (positive) or lost (negative) since t = 0: the scheme's
-// dissipation (γ > ½), a nonlinear material's O(Δt²) share, or energy that nothing supplied.
+// step's start. The coupling force F_c and the contact force (2 beta lambda) act over the step as
+// impulses (assembly.cpp, newmark.cpp): with the trapezoidal rule (gamma = 1/2, beta = 1/4)
+//   M (v^(n+1) - v^n) = dt (1/2 (f^n + f^(n+1)) + F_c + F_k),   x^(n+1) - x^n = dt/2 (v^n + v^(n+1)),
+// f = F - Q the scene's loads less the internal force, so the kinetic energy changes by
+// (x^(n+1) - x^n) . (1/2 (f^n + f^(n+1)) + F_c + F_k), and for a linear elastic body the strain
+// energy and the load potential by exactly the f part:
+//   W += (F_c^(n+1) + F_k^(n+1)) . (x^(n+1) - x^n)
+// on a dof with mass. A massless dof (rho_s = rho_f) is quasi-static, Q = F + F_c + F_k at each
+// end of the step, and its strain energy changes by the trapezoid 1/2 (F^n + F^(n+1)) . dx of
+// those forces (F^n of the last step taken, zero before the first). So kinetic + strain + load
+// potential − the two works is what the time stepping gained (positive) or lost (negative)
+// since t = 0: Newmark's damping (gamma > 1/2), a nonlinear material's share, the contact
+// force's change between a cut step's parts, or energy that nothing supplied.
 void SolidProgram::add_step_work() {
   double w[2] = {0, 0};
   for (int b = 0; b < m_solver->num_bodies(); ++b) {
@@ -268,8 +272,14 @@ void SolidProgram::add_step_work() {
     };
     for (std::size_t d = 0; d < x.size(); ++d) {
       const double dx = x[d] - m_x_n[b][d];
-      w[0] += 0.5 * (at(m_external_n, b, d) + at(m_external, b, d)) * dx;
-      w[1] += 0.5 * (at(m_contact_n, b, d) + (d < contact.size() ? contact[d] : 0.0)) * dx;
+      const double fc = at(m_external, b, d), fk = d < contact.size() ? contact[d] : 0.0;
+      if (m_solver->massless(b, d)) {
+        w[0] += 0.5 * (at(m_external_n, b, d) + fc) * dx;
+        w[1] += 0.5 * (at(m_contact_n, b, d) + fk) * dx;
+      } else {
+        w[0] += fc * dx;
+        w[1] += fk * dx;
+      }
     }
   }
   m_coupling_work = m_work_start[0] + w[0];

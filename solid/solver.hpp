@@ -181,6 +181,9 @@ class Solver {
   double kinetic_energy() const;
   double strain_energy() const;
   double load_potential() const;
+  // Whether dof d (layout as positions) of elastic body b has no inertia (rho_s = rho_f): its
+  // step is quasi-static, the coupling and contact forces balance the internal ones at t^(n+1).
+  bool massless(int b, std::size_t d) const;
 
   // Per-element det F, von Mises stress (plane-strain Cauchy stress) of body b.
   std::vector<double> element_det_f(int b) const;
