@@ -17,7 +17,7 @@ namespace fluid {
 // A compressible elastic body ([fluid] body_divergence). The forcing holds the fluid on a
 // body's faces at the body's velocity ū_s, whose divergence inside the body is the solid's own
 // volume change. A projection that made the fluid divergence-free there too would answer it with
-// the increment φ = (ρ/Δt) L⁻¹ D ū_s, and the incremental projection keeps every increment in p:
+// the increment (ρ/Δt) L⁻¹ D ū_s, and the incremental projection keeps every increment in p:
 // inside the body p grows as (ρ/Δt²) L⁻¹ D of the body's displacement since the start, a penalty
 // on the body's gradient (dilatational) motion of stiffness ρ_f/Δt² per unit volume at any
 // wavelength. The body receives it through the reaction of the next step's forcing, which
@@ -36,8 +36,8 @@ namespace fluid {
 // at the surface, continuous as the body moves: the body's share of the cell), D ū_s,c the
 // divergence of the four faces' mean solid velocities (all four are solid faces where φ_c > 0),
 // whatever the forcing made of them (Crank-Nicolson's solve moves the faces it forced), |c| the
-// cell's area. With a pressure side the fluid outside takes the bodies' net
-// volume change through it, and d̄ = 0. Without one (walls, periodic sides, inflows, outflows
+// cell's area. With a pressure side the fluid outside takes the bodies' net volume change
+// through it, and d̄ = 0. Without one (walls, periodic sides, inflows, outflows
 // whose flux is set) the Poisson problem is singular and compatible only with Σ (D ũ − S) |c| =
 // the boundary's net inflow, so d̄ takes the bodies' net volume change out (Σ S_c |c| = 0): in a
 // closed box an incompressible fluid keeps the bodies' total volume, as it would physically. Then

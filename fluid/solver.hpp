@@ -118,7 +118,7 @@ class Solver {
   const Field& v() const { return m_v; }
   const Field& p() const { return m_p; }
   // body_divergence = "solid": the divergence the last projection left in each cell on purpose
-  // (φ D u~ inside elastic bodies, projection.cpp; zero elsewhere), for the health check.
+  // (S_c inside elastic bodies, projection.cpp; zero elsewhere), for the health check.
   // Null before any.
   const Field* allowed_divergence() const {
     return m_div_allowed.a.empty() ? nullptr : &m_div_allowed;
