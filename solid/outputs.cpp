@@ -86,7 +86,7 @@ std::vector<double> Solver::element_von_mises(int b) const {
   return out;
 }
 
-std::vector<double> Solver::contact_forces(int b) const {
+const std::vector<double>& Solver::contact_forces(int b) const {
   return m_bodies[b]->contact;
 }
 

@@ -266,7 +266,7 @@ void SolidProgram::add_step_work() {
   for (int b = 0; b < m_solver->num_bodies(); ++b) {
     if (m_solver->kind(b) != BodyKind::elastic || b >= static_cast<int>(m_x_n.size())) continue;
     const std::vector<double>& x = m_solver->positions(b);
-    const std::vector<double> contact = m_solver->contact_forces(b);
+    const std::vector<double>& contact = m_solver->contact_forces(b);
     const auto at = [](const std::vector<std::vector<double>>& f, int b, std::size_t d) {
       return b < static_cast<int>(f.size()) && d < f[b].size() ? f[b][d] : 0.0;
     };

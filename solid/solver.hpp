@@ -191,7 +191,7 @@ class Solver {
 
   // Contact: the multiplier force on each surface node of body b (layout as positions; force ON
   // body b) and the normal contact pressure per node (force / tributary current length).
-  std::vector<double> contact_forces(int b) const;
+  const std::vector<double>& contact_forces(int b) const;
   std::vector<double> contact_pressure(int b) const;
   Vec2 total_contact_force(int b) const;
   double min_contact_gap()
