@@ -50,20 +50,27 @@ bool may_change(const std::string& path) {
          path == "fluid.ranks";
 }
 
-std::string first_difference(const Toml& a, const Toml& b, const std::string& path) {
+// A key that only one side has is a difference unless `reads` says this program does not read
+// it: an effective scene holds the defaults its own program filled in, so the scene.effective.toml
+// a run writes (every program's defaults) has keys that another program's checkpoint lacks, with
+// the values that program used. The program that reads such a key compares it itself.
+std::string first_difference(const Toml& a, const Toml& b, const std::string& path, const ReadsKey& reads) {
   if (!path.empty() && may_change(path)) return {};
+  auto one_sided = [&](const std::string& k, const std::string& p) {
+    return !may_change(p) && (!reads || reads(path, k));
+  };
   if (a.is_table() && b.is_table()) {
     for (const auto& [k, v] : a.as_table()) {
       const std::string p = path.empty() ? k : path + "." + k;
       if (!b.as_table().count(k)) {
-        if (!may_change(p)) return p;
+        if (one_sided(k, p)) return p;
         continue;
       }
-      if (auto d = first_difference(v, b.as_table().at(k), p); !d.empty()) return d;
+      if (auto d = first_difference(v, b.as_table().at(k), p, reads); !d.empty()) return d;
     }
     for (const auto& [k, v] : b.as_table()) {
       const std::string p = path.empty() ? k : path + "." + k;
-      if (!a.as_table().count(k) && !may_change(p)) return p;
+      if (!a.as_table().count(k) && one_sided(k, p)) return p;
     }
     return {};
   }
@@ -72,7 +79,7 @@ std::string first_difference(const Toml& a, const Toml& b, const std::string& pa
     const auto& y = b.as_array();
     if (x.size() != y.size()) return path;
     for (std::size_t i = 0; i < x.size(); ++i)
-      if (auto d = first_difference(x[i], y[i], fmt::format("{}[{}]", path, i)); !d.empty()) return d;
+      if (auto d = first_difference(x[i], y[i], fmt::format("{}[{}]", path, i), reads); !d.empty()) return d;
     return {};
   }
   return a == b ? std::string() : path;
@@ -194,8 +201,8 @@ ProbeCsv output_csv(const Runtime& rt, const std::filesystem::path& path, std::v
   return ProbeCsv::resume(path, std::move(columns), restart_time(rt));
 }
 
-std::string changed_physics_key(const std::string& before, const std::string& now) {
-  return first_difference(parse_toml(before, "checkpoint"), parse_toml(now, "scene"), "");
+std::string changed_physics_key(const std::string& before, const std::string& now, const ReadsKey& reads) {
+  return first_difference(parse_toml(before, "checkpoint"), parse_toml(now, "scene"), "", reads);
 }
 
 // Checked by every program on its own file before anything of the run is opened (runtime.cpp),
@@ -222,7 +229,10 @@ void check_checkpoint_version(const std::filesystem::path& out_dir, long step, R
 H5File open_restart(const Runtime& rt) {
   const long step = *rt.restart_step();
   H5File h5(checkpoint_file(rt.out_dir(), step, rt.role()), H5File::Mode::read_only);
-  const std::string key = changed_physics_key(h5.attribute_string("/", "scene"), rt.scene().effective_toml());
+  const Scene& scene = rt.scene();
+  const std::string key =
+      changed_physics_key(h5.attribute_string("/", "scene"), scene.effective_toml(),
+                          [&](const std::string& t, const std::string& k) { return scene.asked(t, k); });
   if (!key.empty())
     throw InputError(fmt::format(
         "{} differs from the run being resumed (checkpoint of step {} in {}): a restart may change "

@@ -60,7 +60,10 @@ double restart_time(const Runtime& rt);
 double restart_fields_time(const Runtime& rt);
 
 // The first key whose value differs between two effective scenes (TOML texts), outside the keys
-// a restart may change (see open_restart); empty when there is none.
-std::string changed_physics_key(const std::string& before, const std::string& now);
+// a restart may change (see open_restart); empty when there is none. With `reads`, a key that
+// only one of the two has counts when reads(table, key) says this program reads it.
+using ReadsKey = std::function<bool(const std::string& table, const std::string& key)>;
+std::string changed_physics_key(const std::string& before, const std::string& now,
+                                const ReadsKey& reads = nullptr);
 
 }  // namespace fsi

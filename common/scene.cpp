@@ -118,6 +118,11 @@ std::uint64_t Scene::hash() const { return proto::fnv1a(m_doc->contents); }
 
 std::string Scene::effective_toml() const { return toml::format(m_doc->effective); }
 
+bool Scene::asked(const std::string& table, const std::string& key) const {
+  const auto it = m_doc->asked.find(table);
+  return it != m_doc->asked.end() && it->second.count(key);
+}
+
 // ---------------------------------------------------------------------------------------------
 // SceneTable
 

@@ -62,6 +62,30 @@ TEST_CASE("a key the checkpoint's scene lacks, or holds and the scene lacks, cou
         "fluid.forcing_time");
 }
 
+// Each program's checkpoint holds its own effective scene; the scene.effective.toml a run writes
+// also holds the defaults the other programs filled in. Resumed with it, a program passes over
+// the keys only one side has that it does not read, and still refuses those it reads.
+TEST_CASE("a key only one side has counts only for the program that reads it", "[checkpoint]") {
+  using fsi::changed_physics_key;
+  const std::string merged = kScene + "[coupler]\nfootprint_smoothing = 0.0\n";
+  const auto fluid_reads = [](const std::string& table, const std::string& key) {
+    return table.starts_with("fluid") || (table.empty() && key == "fluid");
+  };
+  const auto coupler_reads = [](const std::string& table, const std::string& key) {
+    return table == "coupler" || (table.empty() && key == "coupler");
+  };
+  CHECK(changed_physics_key(kScene, merged, fluid_reads).empty());
+  CHECK(changed_physics_key(merged, kScene, fluid_reads).empty());
+  CHECK(changed_physics_key(kScene, merged, coupler_reads) == "coupler");
+  CHECK(changed_physics_key(kScene, merged) == "coupler");
+  const std::string denser = replaced(kScene, "viscosity = 0.01", "viscosity = 0.01\ndensity = 2.0");
+  CHECK(changed_physics_key(kScene, denser, fluid_reads) == "fluid.density");
+  CHECK(changed_physics_key(kScene, denser, coupler_reads).empty());
+  // A value both sides hold is compared whoever reads it.
+  CHECK(changed_physics_key(merged, replaced(merged, "smoothing = 0.0", "smoothing = 0.5"), fluid_reads) ==
+        "coupler.footprint_smoothing");
+}
+
 TEST_CASE("the restart takes the newest step every program completed", "[checkpoint]") {
   const auto out = std::filesystem::temp_directory_path() / "fsi_test_checkpoint";
   std::filesystem::remove_all(out);

@@ -16,6 +16,8 @@ crash while writing): the restart must pass it by. With --change 'OLD=>NEW' a re
 scene with that text replaced must first be refused with an error naming --key. With
 --older-version the checkpoint's files are first marked as written by protocol version 7: the
 restart must be refused naming it (then the marks are put back).
+--effective resumes with the scene.effective.toml the stopped run wrote (its t_end made T): the
+scene as run, with every program's defaults filled in, is the same scene.
 --fluid-ranks runs the stopped run's fluid on P ranks, --restart-ranks the restart's on Q (the
 run straight through stays on one): a checkpoint holds the whole grid whatever the rank count.
 Compared: every CSV file byte for byte and every numeric HDF5 dataset (compare_outputs.py), and
@@ -115,6 +117,8 @@ def main():
                     help="a checkpoint of protocol version 7 must be refused")
     ap.add_argument("--fluid-ranks", type=int, default=1, help="the stopped run's fluid ranks")
     ap.add_argument("--restart-ranks", type=int, help="the restart's fluid ranks (default: --fluid-ranks)")
+    ap.add_argument("--effective", action="store_true",
+                    help="resume with the stopped run's scene.effective.toml (its t_end made T)")
     a = ap.parse_args()
     a.extra = a.extra.replace("\\n", "\n")
     scene = os.path.abspath(a.scene)
@@ -188,7 +192,21 @@ def main():
                 sys.exit("restart_same: the refused restart changed the output folder")
             shutil.rmtree(older)
             print("restart_same: checkpoints of older builds are refused, the output untouched")
-        log = run(a.bin, full, ["--restart", stopped], "restart", a.restart_ranks or a.fluid_ranks)
+        resume = full
+        if a.effective:
+            # The effective scene as the run wrote it, every program's defaults filled in: only
+            # [time] t_end changed to the full run's.
+            resume = os.path.join(work, "effective.toml")
+            made.append(resume)
+            table, lines = "", []
+            for line in open(os.path.join(stopped, "scene.effective.toml")).read().splitlines():
+                if line.startswith("["):
+                    table = line.strip()
+                if table == "[time]" and line.startswith("t_end ="):
+                    line = f"t_end = {a.t_end!r}"
+                lines.append(line)
+            open(resume, "w").write("\n".join(lines) + "\n")
+        log = run(a.bin, resume, ["--restart", stopped], "restart", a.restart_ranks or a.fluid_ranks)
         print(log.strip().splitlines()[-1] if log.strip() else "")
     finally:
         for p in made:
