@@ -308,8 +308,12 @@ Config read_config(const fsi::SceneTable& f, double dt) {
   }
   c.bodies_inviscid = f.choice("body_viscosity", {"none", "kelvin-voigt"}, "none") == "none";
   // Only when given: a scene without it keeps its effective scene (and its checkpoints) as before.
-  if (f.has("body_divergence"))
-    c.bodies_dilate = f.choice("body_divergence", {"zero", "solid"}, "zero") == "solid";
+  if (f.has("body_divergence")) {
+    const std::string d = f.choice("body_divergence", {"zero", "solid", "coupled_step"}, "zero");
+    c.body_divergence = d == "solid"          ? Config::BodyDivergence::solid
+                        : d == "coupled_step" ? Config::BodyDivergence::coupled_step
+                                              : Config::BodyDivergence::zero;
+  }
   if (f.has("forcing_time")) c.forcing_time = f.non_negative("forcing_time");
   // Only when given: a scene without it keeps its effective scene as it was.
   if (f.has("upwind_blend")) c.upwind_blend = f.in_range("upwind_blend", 0.0, 1.0, false, 0.0);

@@ -92,8 +92,11 @@ struct Config {
   // everywhere, inside bodies too; "solid": the projection holds the fluid inside an elastic
   // body at the body's own divergence (its volume change), so that a compressible body is not
   // held incompressible by the fluid it carries (projection.cpp, dilating_cells; for bodies much
-  // heavier than the fluid: fluid/README.md).
-  bool bodies_dilate = false;
+  // heavier than the fluid: fluid/README.md); "coupled_step": "zero" in a step of one substep,
+  // and in a step of m substeps the share 1 − 1/m² of the body's divergence, so that the body's
+  // volume change meets the pressure of one coupled step whatever m (projection.cpp).
+  enum class BodyDivergence { zero, solid, coupled_step };
+  BodyDivergence body_divergence = BodyDivergence::zero;
   // fluid.forcing_time tau >= 0: the immersed forcing's relaxation time (forcing.cpp). A face of
   // volume fraction alpha is blended by beta = alpha dt / ((1 - alpha) tau + alpha dt), so a
   // steady flow's slip in a cut face is (1 - alpha)/alpha tau R whatever dt; < 0 (not given):

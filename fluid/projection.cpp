@@ -45,10 +45,26 @@ namespace fluid {
 // Rigid bodies keep the constraint (their ū_s is divergence-free on covered cells anyway), and so
 // do the cells by a wall (its faces carry no α). This step's cells and φ_c are listed here, from
 // the coupling input; project() uses and then forgets them.
+//
+// body_divergence = "coupled_step" keeps "zero"'s pressure per coupled step under sub-cycling.
+// With m substeps of h = Δt/m and the fluid taking the share w of the divergence,
+//   S_c = w φ_c (D ū_s,c − d̄),
+// each projection adds (ρ/h)(1 − w) L⁻¹ φ D ū_s and the m of them (ρ m² (1 − w)/Δt) L⁻¹ φ D ū_s,
+// which is one plain step's (ρ/Δt) L⁻¹ φ D ū_s for w = 1 − 1/m²: the penalty on the body's
+// volume change stays ρ_f/Δt² whatever m, and m = 1 is "zero" itself. "solid" is w = 1.
+double Solver::dilation_share(int substeps) const {
+  switch (m_cfg.body_divergence) {
+    case Config::BodyDivergence::solid: return 1.0;
+    case Config::BodyDivergence::coupled_step: return 1.0 - 1.0 / (double(substeps) * substeps);
+    case Config::BodyDivergence::zero: break;
+  }
+  return 0.0;
+}
+
 void Solver::dilating_cells(const CouplingIn& in) {
   m_dilating.clear();
   m_dilate_step = false;
-  if (!m_cfg.bodies_dilate) return;
+  if (!(m_dilation_share > 0)) return;
   const std::span<const std::int32_t> idx[2] = {in.solid_u_index, in.solid_v_index};
   const std::span<const double> vel[2] = {in.solid_u_velocity, in.solid_v_velocity};
   const bool mixed[2] = {!in.solid_u_elastic.empty(), !in.solid_v_elastic.empty()};
@@ -167,7 +183,7 @@ void Solver::project(double dt, double t_new) {
       if (sums[1] > 0) mean = sums[0] / sums[1];
     }
     for (const DilatingCell& c : m_dilating) {
-      const double allowed = c.phi * (c.div - mean);
+      const double allowed = m_dilation_share * c.phi * (c.div - mean);
       m_div_allowed(c.i, c.j) = allowed;
       buf[buf_index(c.i, c.j, 0, 0, nt)] -= k * allowed;
     }

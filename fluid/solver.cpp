@@ -125,6 +125,7 @@ Solver::Solver(const Config& c, double dt, MPI_Comm comm)
       m_bnd(m_grid, c.bc, m_dec),
       m_sponge(sponge_weights(m_grid, c.upwind_blend)) {
   validate(c, dt);
+  m_dilation_share = dilation_share(1);
   m_nu = c.viscosity / c.density;
   const int nx = m_grid.nx(), ny = m_grid.ny();
   // The transform axis: x where it is uniform, else y (stretched too: its eigenvectors).
@@ -355,6 +356,14 @@ void Solver::end_step(double dt, const CouplingIn& in, CouplingOut& out) {
 void Solver::end_substeps(double dt, int m, const CouplingIn& in, CouplingOut& out) {
   if (m == 1) return end_step(dt, in, out);
   if (m < 1) fsi::fail("fluid::Solver::end_substeps: {} substeps", m);
+  // body_divergence = "coupled_step": the share of the bodies' divergence for m substeps, back to
+  // a plain step's when they are done (also when one throws).
+  struct Share {
+    double& w;
+    double plain;
+    ~Share() { w = plain; }
+  } share{m_dilation_share, dilation_share(1)};
+  m_dilation_share = dilation_share(m);
   const double h = dt / m;
   m_force_sum[0].assign(in.solid_u_index.size(), 0.0);
   m_force_sum[1].assign(in.solid_v_index.size(), 0.0);

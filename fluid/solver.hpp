@@ -262,6 +262,10 @@ class Solver {
   };
   std::vector<DilatingCell> m_dilating, m_dilated;
   bool m_dilate_step = false;  // dilating_cells() found elastic faces on some rank
+  // The share w of the bodies' divergence the fluid takes in this (sub)step: S_c = w φ_c (...),
+  // set for the step's substep count by end_substeps (dilation_share, projection.cpp).
+  double m_dilation_share = 0;
+  double dilation_share(int substeps) const;  // projection.cpp
   std::array<Field, 2> m_dil_alpha, m_dil_us;
   std::vector<double> m_dil_rows;
   Field m_div_allowed;

@@ -24,7 +24,7 @@ def body_viscosity(p, what):
 def body_divergence(p, what):
     """The --body-divergence option of a case whose runs WHAT ([fluid] body_divergence written
     into its scenes; not given: the fluid's default)."""
-    p.add_argument("--body-divergence", choices=("solid", "zero"), default=None,
+    p.add_argument("--body-divergence", choices=("solid", "zero", "coupled_step"), default=None,
                    help=f"[fluid] body_divergence of {what} (default: not written, the fluid's "
                         "own), outputs under OUT/.../body-divergence-X")
 

@@ -15,8 +15,8 @@ central convection stable in the jet), --newmark-gamma 0.5.
 --short: h = 0 (the folds touch at t = 0) on a coarse grid through the first contact episodes;
   fails when contact in the flow breaks (Newton, penetration) or the run stops.
 --run H: one coupled run at clearance h/D = H (--grid paper|coarse, --t-end T (default 12),
-  --impulsive: no inflow ramp, --upwind B, --p-sub P: a pressure inlet, on the paper's grid at
-  dt = 2.5e-5, half the paper's step, unless --dt is given).
+  --impulsive: no inflow ramp, --upwind B, --p-sub P: a pressure inlet, with the fluid's
+  body_divergence = "coupled_step" unless --body-divergence is given).
 --sweep: the clearance sweep (paper Sec. 5.1): h = 0, 0.01, 0.02, 0.04, 0.05 with the velocity
   inflow and h = 0 with a pressure inlet (P = 5000), on --grid (default paper) to --t-end
   (default 12) with --upwind (default 0; 0.2 with --convection central); with --modes. A run of
@@ -44,7 +44,11 @@ runs are in OUT/neo-hookean/planes/substeps-4/upwind3.
   body_viscosity; the runs of README.md before the fluid's default became "none" did), outputs
   under OUT/.../body-viscosity-kelvin-voigt.
 --body-divergence solid: the fluid in the folds takes their divergence ([fluid] body_divergence;
-  README.md, "What stops the pressure inlet"), outputs under OUT/.../body-divergence-solid.
+  README.md, "What stops the pressure inlet"), outputs under OUT/.../body-divergence-solid;
+  coupled_step: the share 1 - 1/m^2 of it in a step of m substeps, the pressure of one coupled
+  step whatever m (OUT/.../body-divergence-coupled_step). Without the option the velocity
+  inflow's runs take the fluid's default ("zero", the paper's), the pressure inlet's
+  "coupled_step" (README.md, "What stops the pressure inlet").
 --checkpoint-interval T: the coupled runs write a checkpoint every T (`./fsi run SCENE --restart
   RUN` resumes one; the outputs are unchanged).
 With no option (`./fsi validate vocal-folds`): --modes, --short and --sweep."""
@@ -176,11 +180,13 @@ bodies = ["upper"]
 """, 1)
     if ARGS.dt is not None and fluid:
         text = text.replace("dt = 5e-5", f"dt = {ARGS.dt!r}")
-    elif p_sub is not None and grid == "paper":
-        # The pressure inlet at half the paper's step unless --dt says otherwise: at 5e-5 the
-        # sub-cycled fluid's pressure in the compressible folds feeds them until the run stops,
-        # at 2.5e-5 it reaches t = 12 (README.md, "What stops the pressure inlet").
-        text = text.replace("dt = 5e-5", "dt = 2.5e-5")
+    if p_sub is not None and ARGS.body_divergence is None:
+        # The pressure inlet keeps the fluid's pressure in the compressible folds at one coupled
+        # step's whatever the substeps: under "zero" each substep adds it again and, at the
+        # paper's step, feeds the folds until the run stops (README.md, "What stops the
+        # pressure inlet"; fluid/README.md, body_divergence).
+        text = text.replace("viscosity = 6.666666666666667e-4",
+                            'viscosity = 6.666666666666667e-4\nbody_divergence = "coupled_step"')
     if ARGS.checkpoint_interval is not None and fluid:
         text = text.replace("[output]\n", f"[output]\ncheckpoint_interval = {ARGS.checkpoint_interval!r}\n", 1)
     if ARGS.substeps and fluid:

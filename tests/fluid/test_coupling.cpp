@@ -624,10 +624,10 @@ struct Dilating {
   double div_sum = 0;                    // sum of D u |c| over the grid
   double health = 0;                     // max_divergence (the allowed part taken out)
 };
-Dilating dilating_block(bool dilate, BcType sides, int steps) {
+Dilating dilating_block(Config::BodyDivergence mode, BcType sides, int steps, int substeps = 1) {
   const double dt = 1e-3, eps = 0.4, xc = 0.5, yc = 0.25;
   Config c = box(sides);
-  c.bodies_dilate = dilate;
+  c.body_divergence = mode;
   Solver s(c, dt);
   const Grid& g = s.grid();
   const double hx = g.x().h(), hy = g.y().h();
@@ -651,7 +651,8 @@ Dilating dilating_block(bool dilate, BcType sides, int steps) {
   Dilating r;
   for (int n = 0; n < steps; ++n) {
     const double p0 = s.p()(8, 4);
-    s.step(dt, in, out);
+    s.begin_step(dt / substeps);
+    s.end_substeps(dt, substeps, in, out);
     r.dp.push_back(s.p()(8, 4) - p0);
   }
   for (int j = 0; j < g.ny(); ++j)
@@ -678,8 +679,8 @@ TEST_CASE("body_divergence: the fluid in a dilating body takes its divergence, n
           "[fluid][coupling]") {
   const double rate = 2 * 0.4;  // D u_s
   // Pressure sides: the fluid outside takes the block's growth.
-  const Dilating zero = dilating_block(false, BcType::pressure, 20);
-  const Dilating solid = dilating_block(true, BcType::pressure, 20);
+  const Dilating zero = dilating_block(Config::BodyDivergence::zero, BcType::pressure, 20);
+  const Dilating solid = dilating_block(Config::BodyDivergence::solid, BcType::pressure, 20);
   // "zero": the same increment every step (after the fluid outside has started: steps 10-19),
   // the block's dilatation answered again and again.
   double zero_sum = 0, solid_sum = 0;
@@ -699,8 +700,36 @@ TEST_CASE("body_divergence: the fluid in a dilating body takes its divergence, n
   CHECK(solid.health <= 1e-9 * rate);
   // Closed by walls: the bodies' net volume change is taken out (the Poisson problem's
   // compatibility), so a block dilating uniformly is held as with "zero".
-  const Dilating closed = dilating_block(true, BcType::wall, 3);
+  const Dilating closed = dilating_block(Config::BodyDivergence::solid, BcType::wall, 3);
   for (double d : closed.div_inside) CHECK(std::abs(d) <= 1e-9 * rate);
   CHECK(std::abs(closed.div_sum) <= 1e-12);
   CHECK(closed.health <= 1e-9 * rate);
+}
+
+// Sub-cycled, "zero" answers the block's dilatation once per substep with increments m times a
+// plain step's, m² per coupled step; "coupled_step" takes the share 1 − 1/m² of the divergence
+// in each substep and keeps one plain step's pressure per coupled step (projection.cpp).
+TEST_CASE("body_divergence: coupled_step keeps a plain step's pressure under substeps",
+          "[fluid][coupling]") {
+  using BD = Config::BodyDivergence;
+  const Dilating plain = dilating_block(BD::zero, BcType::pressure, 20);
+  // One substep: "zero" itself, bit for bit.
+  const Dilating one = dilating_block(BD::coupled_step, BcType::pressure, 20);
+  REQUIRE(one.dp.size() == plain.dp.size());
+  for (std::size_t n = 0; n < plain.dp.size(); ++n) CHECK(one.dp[n] == plain.dp[n]);
+  for (int m : {2, 3}) {
+    CAPTURE(m);
+    const Dilating zero = dilating_block(BD::zero, BcType::pressure, 20, m);
+    const Dilating shared = dilating_block(BD::coupled_step, BcType::pressure, 20, m);
+    double p1 = 0, pz = 0, ps = 0;
+    for (std::size_t n = 10; n < 20; ++n) p1 += plain.dp[n], pz += zero.dp[n], ps += shared.dp[n];
+    REQUIRE(std::abs(p1) > 0);
+    CHECK(std::abs(pz / p1 - m * m) <= 0.01 * m * m);
+    CHECK(std::abs(ps / p1 - 1) <= 0.01);
+    // The rest of the body's divergence stays in its cells, the fluid around it incompressible.
+    for (double d : shared.div_inside) CHECK(std::abs(d - (1 - 1.0 / (m * m)) * 0.8) <= 1e-9);
+    CHECK(shared.div_outside <= 1e-9);
+    CHECK(shared.health <= 1e-9);
+    CHECK(shared.health_after <= 1e-9);
+  }
 }
