@@ -53,8 +53,10 @@ bool may_change(const std::string& path) {
 // A key that only one side has is a difference unless `reads` says this program does not read
 // it: an effective scene holds the defaults its own program filled in, so the scene.effective.toml
 // a run writes (every program's defaults) has keys that another program's checkpoint lacks, with
-// the values that program used. The program that reads such a key compares it itself.
-std::string first_difference(const Toml& a, const Toml& b, const std::string& path, const ReadsKey& reads) {
+// the values that program used. The program that reads such a key compares it itself. `side`
+// says where a key only one side has is: 1 before only, 2 now only (0: a value that differs).
+std::string first_difference(const Toml& a, const Toml& b, const std::string& path, const ReadsKey& reads,
+                             int& side) {
   if (!path.empty() && may_change(path)) return {};
   auto one_sided = [&](const std::string& k, const std::string& p) {
     return !may_change(p) && (!reads || reads(path, k));
@@ -63,14 +65,14 @@ std::string first_difference(const Toml& a, const Toml& b, const std::string& pa
     for (const auto& [k, v] : a.as_table()) {
       const std::string p = path.empty() ? k : path + "." + k;
       if (!b.as_table().count(k)) {
-        if (one_sided(k, p)) return p;
+        if (one_sided(k, p)) return side = 1, p;
         continue;
       }
-      if (auto d = first_difference(v, b.as_table().at(k), p, reads); !d.empty()) return d;
+      if (auto d = first_difference(v, b.as_table().at(k), p, reads, side); !d.empty()) return d;
     }
     for (const auto& [k, v] : b.as_table()) {
       const std::string p = path.empty() ? k : path + "." + k;
-      if (!a.as_table().count(k) && one_sided(k, p)) return p;
+      if (!a.as_table().count(k) && one_sided(k, p)) return side = 2, p;
     }
     return {};
   }
@@ -79,7 +81,8 @@ std::string first_difference(const Toml& a, const Toml& b, const std::string& pa
     const auto& y = b.as_array();
     if (x.size() != y.size()) return path;
     for (std::size_t i = 0; i < x.size(); ++i)
-      if (auto d = first_difference(x[i], y[i], fmt::format("{}[{}]", path, i), reads); !d.empty()) return d;
+      if (auto d = first_difference(x[i], y[i], fmt::format("{}[{}]", path, i), reads, side); !d.empty())
+        return d;
     return {};
   }
   return a == b ? std::string() : path;
@@ -201,8 +204,12 @@ ProbeCsv output_csv(const Runtime& rt, const std::filesystem::path& path, std::v
   return ProbeCsv::resume(path, std::move(columns), restart_time(rt));
 }
 
-std::string changed_physics_key(const std::string& before, const std::string& now, const ReadsKey& reads) {
-  return first_difference(parse_toml(before, "checkpoint"), parse_toml(now, "scene"), "", reads);
+std::string changed_physics_key(const std::string& before, const std::string& now, const ReadsKey& reads,
+                                int* side) {
+  int s = 0;
+  std::string key = first_difference(parse_toml(before, "checkpoint"), parse_toml(now, "scene"), "", reads, s);
+  if (side) *side = s;
+  return key;
 }
 
 // Checked by every program on its own file before anything of the run is opened (runtime.cpp),
@@ -230,14 +237,19 @@ H5File open_restart(const Runtime& rt) {
   const long step = *rt.restart_step();
   H5File h5(checkpoint_file(rt.out_dir(), step, rt.role()), H5File::Mode::read_only);
   const Scene& scene = rt.scene();
-  const std::string key =
-      changed_physics_key(h5.attribute_string("/", "scene"), scene.effective_toml(),
-                          [&](const std::string& t, const std::string& k) { return scene.asked(t, k); });
+  int side = 0;
+  const std::string key = changed_physics_key(
+      h5.attribute_string("/", "scene"), scene.effective_toml(),
+      [&](const std::string& t, const std::string& k) { return scene.reads(t, k); }, &side);
   if (!key.empty())
     throw InputError(fmt::format(
-        "{} differs from the run being resumed (checkpoint of step {} in {}): a restart may change "
-        "time.t_end and [output] only (in {})",
-        key, step, rt.out_dir().string(), rt.scene().file().string()));
+        "{} {} (checkpoint of step {} in {}): a restart may change time.t_end and [output] only "
+        "(in {})",
+        key,
+        side == 1   ? "is set in the run being resumed and not in this scene"
+        : side == 2 ? "is set in this scene and not in the run being resumed"
+                    : "differs from the run being resumed",
+        step, rt.out_dir().string(), rt.scene().file().string()));
   return h5;
 }
 

@@ -39,7 +39,8 @@ void check_checkpoint_version(const std::filesystem::path& out_dir, long step, R
 
 // A restarted program's checkpoint file, opened for reading, after checking that the scene's
 // physics did not change: every key of the effective scene but time.t_end, [output],
-// scene.description and [test] must be as it was (an InputError names the first that changed).
+// scene.description and [test] must be as it was, and a key set on one side only counts when
+// this program reads it (changed_physics_key; an InputError names the first that changed).
 H5File open_restart(const Runtime& rt);
 
 // Output files that continue at a restart: created afresh in a new run; in a restarted one
@@ -61,9 +62,10 @@ double restart_fields_time(const Runtime& rt);
 
 // The first key whose value differs between two effective scenes (TOML texts), outside the keys
 // a restart may change (see open_restart); empty when there is none. With `reads`, a key that
-// only one of the two has counts when reads(table, key) says this program reads it.
+// only one of the two has counts when reads(table, key) says this program reads it; `side`, when
+// given, is set to 1 for a key only `before` has, 2 for one only `now` has, else 0.
 using ReadsKey = std::function<bool(const std::string& table, const std::string& key)>;
 std::string changed_physics_key(const std::string& before, const std::string& now,
-                                const ReadsKey& reads = nullptr);
+                                const ReadsKey& reads = nullptr, int* side = nullptr);
 
 }  // namespace fsi

@@ -23,6 +23,9 @@ struct SceneDoc {
   Value root;
   Value effective;
   std::map<std::string, std::set<std::string>> asked;  // table path -> keys asked for
+  // table path -> keys whose presence was checked (has()): read only when given, so absent
+  // from the effective scene otherwise; not "asked" (a check alone does not make a key known).
+  std::map<std::string, std::set<std::string>> checked;
 };
 
 namespace {
@@ -118,9 +121,12 @@ std::uint64_t Scene::hash() const { return proto::fnv1a(m_doc->contents); }
 
 std::string Scene::effective_toml() const { return toml::format(m_doc->effective); }
 
-bool Scene::asked(const std::string& table, const std::string& key) const {
-  const auto it = m_doc->asked.find(table);
-  return it != m_doc->asked.end() && it->second.count(key);
+bool Scene::reads(const std::string& table, const std::string& key) const {
+  for (const auto* record : {&m_doc->asked, &m_doc->checked}) {
+    const auto it = record->find(table);
+    if (it != record->end() && it->second.count(key)) return true;
+  }
+  return false;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -145,6 +151,7 @@ const void* SceneTable::lookup(std::string_view key) const {
 }
 
 bool SceneTable::has(std::string_view key) const {
+  m_doc->checked[m_path].insert(std::string(key));
   const auto& table = as_value(m_value).as_table();
   return table.count(std::string(key)) != 0;
 }

@@ -91,8 +91,9 @@ class Scene {
   std::uint64_t hash() const;            // FNV-1a of the contents
   // The effective scene: every key read so far, with defaults filled in, as TOML text.
   std::string effective_toml() const;
-  // Whether this program asked for `key` of the table at `table` ("" the top, "a.b[2]").
-  bool asked(const std::string& table, const std::string& key) const;
+  // Whether this program asked for `key` of the table at `table` ("" the top, "a.b[2]"), or
+  // checked whether it is given (a key read only when given).
+  bool reads(const std::string& table, const std::string& key) const;
   // Every number of the scene with |value| >= `threshold` (or not finite), as "key = value",
   // largest first: what a health check names as the likely cause of a blow-up.
   std::vector<std::string> extreme_numbers(double threshold) const;

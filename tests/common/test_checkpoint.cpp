@@ -3,6 +3,7 @@
 #include <fstream>
 
 #include "checkpoint.hpp"
+#include "scene.hpp"
 
 namespace {
 
@@ -62,28 +63,89 @@ TEST_CASE("a key the checkpoint's scene lacks, or holds and the scene lacks, cou
         "fluid.forcing_time");
 }
 
+namespace {
+// Two programs reading a scene file as programs do: every one skips the others' top-level
+// tables; "fluid" reads fluid.viscosity, fluid.density with a default (filled into its effective
+// scene) and fluid.upwind_blend only when given; "solid" reads each [[solid.body]]'s name and its
+// density with a default. The scene as the program read it.
+enum class Reader { fluid, solid };
+fsi::Scene read_as(Reader who, const std::string& text) {
+  const auto file = std::filesystem::temp_directory_path() / "fsi_test_checkpoint_scene.toml";
+  std::ofstream(file) << text;
+  fsi::Scene scene(file);
+  const fsi::SceneTable root = scene.root();
+  for (const char* k : {"scene", "time", "fluid", "solid", "coupler"}) root.skip(k);
+  if (who == Reader::fluid) {
+    const fsi::SceneTable f = root.table("fluid");
+    f.number("viscosity");
+    f.number("density", 1.0);
+    if (f.has("upwind_blend")) f.number("upwind_blend");
+  } else {
+    for (const fsi::SceneTable& b : root.table("solid").tables("body")) {
+      b.string("name");
+      b.number("density", 1.0);
+    }
+  }
+  std::filesystem::remove(file);
+  return scene;
+}
+
+// changed_physics_key as open_restart calls it: the checkpoint's effective scene (the program's
+// reading of the run's scene) against the program's reading of the resumed scene.
+std::string resumed(Reader who, const std::string& run, const std::string& resume, int* side = nullptr) {
+  const fsi::Scene before = read_as(who, run);
+  const fsi::Scene now = read_as(who, resume);
+  return fsi::changed_physics_key(
+      before.effective_toml(), now.effective_toml(),
+      [&](const std::string& t, const std::string& k) { return now.reads(t, k); }, side);
+}
+
+const std::string kRun = R"(
+[time]
+dt = 0.01
+t_end = 1.0
+[fluid]
+viscosity = 0.01
+upwind_blend = 0.2
+[solid]
+[[solid.body]]
+name = "a"
+[coupler]
+gain = 0.5
+)";
+}  // namespace
+
 // Each program's checkpoint holds its own effective scene; the scene.effective.toml a run writes
-// also holds the defaults the other programs filled in. Resumed with it, a program passes over
-// the keys only one side has that it does not read, and still refuses those it reads.
+// holds every program's defaults. Resumed with it, a program passes over the keys only one side
+// has that it neither reads nor checks for, and refuses those it does.
 TEST_CASE("a key only one side has counts only for the program that reads it", "[checkpoint]") {
-  using fsi::changed_physics_key;
-  const std::string merged = kScene + "[coupler]\nfootprint_smoothing = 0.0\n";
-  const auto fluid_reads = [](const std::string& table, const std::string& key) {
-    return table.starts_with("fluid") || (table.empty() && key == "fluid");
-  };
-  const auto coupler_reads = [](const std::string& table, const std::string& key) {
-    return table == "coupler" || (table.empty() && key == "coupler");
-  };
-  CHECK(changed_physics_key(kScene, merged, fluid_reads).empty());
-  CHECK(changed_physics_key(merged, kScene, fluid_reads).empty());
-  CHECK(changed_physics_key(kScene, merged, coupler_reads) == "coupler");
-  CHECK(changed_physics_key(kScene, merged) == "coupler");
-  const std::string denser = replaced(kScene, "viscosity = 0.01", "viscosity = 0.01\ndensity = 2.0");
-  CHECK(changed_physics_key(kScene, denser, fluid_reads) == "fluid.density");
-  CHECK(changed_physics_key(kScene, denser, coupler_reads).empty());
-  // A value both sides hold is compared whoever reads it.
-  CHECK(changed_physics_key(merged, replaced(merged, "smoothing = 0.0", "smoothing = 0.5"), fluid_reads) ==
-        "coupler.footprint_smoothing");
+  // The run's effective scene: both programs' defaults in it.
+  const std::string merged = replaced(replaced(kRun, "upwind_blend = 0.2", "upwind_blend = 0.2\ndensity = 1.0"),
+                                      "name = \"a\"", "name = \"a\"\ndensity = 1.0");
+  CHECK(resumed(Reader::fluid, kRun, merged).empty());
+  CHECK(resumed(Reader::solid, kRun, merged).empty());
+  // ... and back from a run resumed with it to the scene it started from.
+  CHECK(resumed(Reader::fluid, merged, kRun).empty());
+  CHECK(resumed(Reader::solid, merged, kRun).empty());
+  // A key read only when given, removed or added: the program that checks for it refuses, and
+  // says on which side it is set.
+  int side = -1;
+  const std::string without = replaced(kRun, "upwind_blend = 0.2\n", "");
+  CHECK(resumed(Reader::fluid, kRun, without, &side) == "fluid.upwind_blend");
+  CHECK(side == 1);
+  CHECK(resumed(Reader::fluid, without, kRun, &side) == "fluid.upwind_blend");
+  CHECK(side == 2);
+  CHECK(resumed(Reader::solid, kRun, without).empty());
+  // A default a program fills in, given another value: a value that differs, for that program.
+  const std::string denser = replaced(kRun, "name = \"a\"", "name = \"a\"\ndensity = 2.0");
+  CHECK(resumed(Reader::solid, kRun, denser, &side) == "solid.body[0].density");
+  CHECK(side == 0);
+  CHECK(resumed(Reader::fluid, kRun, denser).empty());
+  // A key no program here reads, in a table both sides have: compared by every program.
+  CHECK(resumed(Reader::fluid, kRun, replaced(kRun, "gain = 0.5", "gain = 0.6")) == "coupler.gain");
+  // Without `reads` (every key counts) the merged scene is refused.
+  CHECK(fsi::changed_physics_key(read_as(Reader::fluid, kRun).effective_toml(),
+                                 read_as(Reader::fluid, merged).effective_toml()) == "solid.body[0].density");
 }
 
 TEST_CASE("the restart takes the newest step every program completed", "[checkpoint]") {

@@ -16,8 +16,8 @@ crash while writing): the restart must pass it by. With --change 'OLD=>NEW' a re
 scene with that text replaced must first be refused with an error naming --key. With
 --older-version the checkpoint's files are first marked as written by protocol version 7: the
 restart must be refused naming it (then the marks are put back).
---effective resumes with the scene.effective.toml the stopped run wrote (its t_end made T): the
-scene as run, with every program's defaults filled in, is the same scene.
+--effective resumes with the scene.effective.toml the stopped run wrote (its t_end made T, put
+beside the scene): the scene as run, with every program's defaults filled in, is the same scene.
 --fluid-ranks runs the stopped run's fluid on P ranks, --restart-ranks the restart's on Q (the
 run straight through stays on one): a checkpoint holds the whole grid whatever the rank count.
 Compared: every CSV file byte for byte and every numeric HDF5 dataset (compare_outputs.py), and
@@ -195,8 +195,9 @@ def main():
         resume = full
         if a.effective:
             # The effective scene as the run wrote it, every program's defaults filled in: only
-            # [time] t_end changed to the full run's.
-            resume = os.path.join(work, "effective.toml")
+            # [time] t_end changed to the full run's. Beside the scene, whose folder its relative
+            # file names (a mesh) are read from.
+            resume = os.path.splitext(scene)[0] + f"_restart_effective_{os.getpid()}.toml"
             made.append(resume)
             table, lines = "", []
             for line in open(os.path.join(stopped, "scene.effective.toml")).read().splitlines():
