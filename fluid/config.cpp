@@ -441,6 +441,13 @@ Config read_config(const fsi::SceneTable& f, double dt) {
                                  kUpwind3Cfl));
     s->finish();
   }
+  // "coupled_step" differs from "zero" in sub-cycled steps only: without substeps it would be a
+  // choice that does nothing.
+  if (c.body_divergence == Config::BodyDivergence::coupled_step && c.substeps_max == 1)
+    f.fail("body_divergence",
+           "= \"coupled_step\" changes only the steps the fluid sub-cycles, and this scene does not "
+           "sub-cycle it ([fluid.substeps] max > 1): set body_divergence = \"zero\" (the same "
+           "steps) or add [fluid.substeps]");
   for (Side s : c.wall_shear) {
     if (c.bc[s].type != BcType::wall) {
       f.fail("diagnostics", fmt::format("wall_shear on side {} which is not a wall", kSideNames[s]));

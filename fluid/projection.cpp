@@ -157,8 +157,9 @@ void Solver::project(double dt, double t_new) {
       }
     }
   }
-  // body_divergence = "solid": the cells inside elastic bodies keep S_c (dilating_cells above),
-  // d̄ summed row by row in row order (the same bits on any number of ranks).
+  // body_divergence = "solid", and "coupled_step" in a sub-cycled step: the cells inside elastic
+  // bodies keep S_c, the share w of it (dilating_cells above), d̄ summed row by row in row order
+  // (the same bits on any number of ranks).
   if (m_div_allowed.a.empty() && m_dilate_step) m_div_allowed = Field(nx, ny, lo, hi);
   for (const DilatingCell& c : m_dilated) m_div_allowed(c.i, c.j) = 0;
   if (m_dilate_step) {

@@ -136,6 +136,23 @@ TEST_CASE("convection: central by default, upwind3, anything else refused",
   CHECK_NOTHROW(read(std::string(kGood) + "\n[fluid.substeps]\nmax = 4\n"));
 }
 
+TEST_CASE("body_divergence: zero by default, solid, coupled_step only with substeps",
+          "[fluid][config]") {
+  using BD = fluid::Config::BodyDivergence;
+  auto with = [](const std::string& keys) {
+    return replace(kGood, "viscosity = 0.01", "viscosity = 0.01\n" + keys);
+  };
+  CHECK(read(kGood).body_divergence == BD::zero);
+  CHECK(read(with("body_divergence = \"solid\"")).body_divergence == BD::solid);
+  const std::string step = with("body_divergence = \"coupled_step\"");
+  CHECK(read(step + "\n[fluid.substeps]\nmax = 2\n").body_divergence == BD::coupled_step);
+  CHECK_THROWS_WITH(read(step), Contains("body_divergence") && Contains("coupled_step") &&
+                                    Contains("[fluid.substeps]") && Contains("fluid_config_test.toml"));
+  CHECK_THROWS_WITH(read(step + "\n[fluid.substeps]\nmax = 1\n"), Contains("body_divergence"));
+  CHECK_THROWS_WITH(read(with("body_divergence = \"some\"")),
+                    Contains("body_divergence") && Contains("some") && Contains("coupled_step"));
+}
+
 TEST_CASE("forcing_time: read with every diffusion and forcing, refused negative",
           "[fluid][config]") {
   auto with = [](const std::string& keys) {
