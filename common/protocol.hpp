@@ -19,7 +19,7 @@
 namespace fsi::proto {
 
 // Bump on any change of a message's layout or of the message order.
-inline constexpr std::int32_t kVersion = 8;
+inline constexpr std::int32_t kVersion = 9;
 inline constexpr std::uint32_t kMagic = 0x4d495346;  // "FSIM"
 
 // The fluid on several ranks: its ny cell rows in blocks of this many, rank r holding rows
@@ -220,12 +220,17 @@ struct StepBegin {  // coupler -> each solver, every step
 // version 8, elastic: the part of alpha that belongs to elastic bodies (kind 0, not rigid), in
 // the same order, which is where the fluid takes its viscosity out of the bodies
 // (fluid.body_viscosity = "none"); empty in both families when every body of the scene is
-// elastic (then it is alpha), else one value per face in both.
+// elastic (then it is alpha), else one value per face in both. Since version 9, shared: 1 for a
+// face whose control volume holds pieces of more than one body (its velocity is the mean over
+// them, whose divergence is their approach, not a volume change: fluid.body_divergence takes
+// none there), else 0; empty in both families when no face of either is shared, else one value
+// per face in both.
 struct FaceSolid {
   std::vector<std::int32_t> index;
   std::vector<double> alpha;
   std::vector<double> velocity;
   std::vector<double> elastic;
+  std::vector<std::int32_t> shared;
 };
 
 // A sparse body force per unit volume on faces (force on the fluid).

@@ -372,6 +372,22 @@ void ImmersedSolid::gather(const Fixed& fixed, const Raw& moving, Faces& p, Scra
     for (std::size_t e = 0; e < moving.size(); ++e)
       if (deforms(moving[e].body)) p.elastic_area[p.slot_moving[e]] += moving[e].area();
   }
+  // Faces that pieces of two bodies cover: there ū_s is the mean of two bodies' velocities,
+  // whose divergence is their approach, not a volume change (FaceSolid::shared).
+  p.shared.clear();
+  p.any_shared = false;
+  if (m_meshes.bodies.size() > 1) {
+    p.shared.assign(nf, 0);
+    auto& owner = p.sum;  // scratch: the first body seen on each face, -1 before
+    owner.assign(nf, -1.0);
+    auto mark = [&](std::int32_t k, int body) {
+      if (owner[k] < 0) owner[k] = body;
+      else if (owner[k] != body) p.shared[k] = 1, p.any_shared = true;
+    };
+    for (std::size_t e = 0; e < fixed.raw.size(); ++e)
+      mark(p.slot_fixed_face[fixed.local[e]], fixed.raw[e].body);
+    for (std::size_t e = 0; e < moving.size(); ++e) mark(p.slot_moving[e], moving[e].body);
+  }
   p.total_area = 0;
   for (std::size_t k = 0; k < nf; ++k) {
     p.total_area += p.area[k];
@@ -458,6 +474,10 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
     family(m_vf, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v);
   }
   m_fixed_done = true;
+  // Sent for every face of both families, or for none when no face is shared.
+  const bool any = m_u.any_shared || m_v.any_shared;
+  u.shared = any ? m_u.shared : std::vector<std::int32_t>{};
+  v.shared = any ? m_v.shared : std::vector<std::int32_t>{};
 }
 
 void ImmersedSolid::update_velocities(const proto::SolidState& state, proto::FaceSolid& u,

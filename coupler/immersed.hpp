@@ -148,6 +148,10 @@ class ImmersedSolid {
     std::vector<std::int32_t> face;
     std::vector<double> area;            // Σ |V ∩ T| of the face
     std::vector<double> elastic_area;    // the same over elastic bodies' T (m_any_rigid only)
+    // 1 where pieces of more than one body cover the face (its ū_s their mean), else 0; empty
+    // with one body. any_shared: some face is.
+    std::vector<std::int32_t> shared;
+    bool any_shared = false;
     std::vector<std::int32_t> slot_moving;
     std::vector<std::int32_t> slot_fixed_face;  // per face of Fixed::face
     const Fixed* fixed = nullptr;

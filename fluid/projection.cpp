@@ -85,11 +85,16 @@ void Solver::dilating_cells(const CouplingIn& in) {
       m_dil_alpha[c] = Field(nx + 1 - c, ny + c, lo, hi);
       m_dil_us[c] = Field(nx + 1 - c, ny + c, lo, hi);
     }
+  // A face that two bodies cover counts as uncovered here: its ū_s is their mean, and the
+  // divergence of two bodies' velocities where they meet is their approach, not a volume change
+  // (taken as one, it made a sink at the vocal folds' closing glottis: fluid/README.md). So a
+  // cell with such a face has φ_c = 0.
+  const std::span<const std::int32_t> shared[2] = {in.solid_u_shared, in.solid_v_shared};
   for (int c = 0; c < 2; ++c)
     for (std::size_t q = 0; q < idx[c].size(); ++q)
       if (alpha[c][q] > 0) {
         const auto [i, j] = face_of(c, idx[c][q]);
-        m_dil_alpha[c](i, j) = std::min(1.0, alpha[c][q]);
+        m_dil_alpha[c](i, j) = !shared[c].empty() && shared[c][q] ? 0.0 : std::min(1.0, alpha[c][q]);
         m_dil_us[c](i, j) = vel[c][q];
       }
   Field &au = m_dil_alpha[0], &av = m_dil_alpha[1], &us = m_dil_us[0], &vs = m_dil_us[1];

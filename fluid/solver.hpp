@@ -44,6 +44,8 @@ struct CouplingIn {
   // The part of alpha that belongs to elastic bodies, in the same order, where body_viscosity =
   // "none" takes the viscosity out; empty when every body is elastic (then alpha).
   std::span<const double> solid_u_elastic, solid_v_elastic;
+  // 1 on faces that more than one body covers (their ū_s a mean over bodies); empty: none.
+  std::span<const std::int32_t> solid_u_shared, solid_v_shared;
   std::span<const std::int32_t> fiber_u_index, fiber_v_index;
   std::span<const double> fiber_u_force, fiber_v_force;
   std::span<const std::int32_t> sample_u_index, sample_v_index;

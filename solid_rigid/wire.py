@@ -11,7 +11,7 @@ import time
 import numpy as np
 from mpi4py import MPI
 
-VERSION = 8
+VERSION = 9
 ANNOUNCE_MAGIC = 0x31495346  # "FSI1"
 MESSAGE_MAGIC = 0x4d495346   # "FSIM"
 LINK_TAG_BASE = 7100         # MPI tag of MPI_Intercomm_create: this plus the solver's role number

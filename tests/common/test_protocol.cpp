@@ -76,6 +76,18 @@ TEST_CASE("every message survives a round trip") {
   const auto fi3 = round_trip(fi);
   CHECK(fi3.solid_u.elastic.empty());
   CHECK(fi3.solid_v.elastic.empty());
+  CHECK(fi3.solid_u.shared.empty());
+  // Faces two bodies cover (version 9): marks on every face of both families.
+  fi.solid_u.shared = {0, 1, 0};
+  fi.solid_v.shared = {0};
+  const auto fi4 = round_trip(fi);
+  CHECK(fi4.solid_u.shared == fi.solid_u.shared);
+  CHECK(fi4.solid_v.shared == fi.solid_v.shared);
+  fi.solid_v.shared.clear();
+  FluidInput back;
+  CHECK_THROWS_WITH(unpack_message(pack_message(fi, 1), back),
+                    Catch::Contains("shared marks sent for some faces only"));
+  fi.solid_u.shared.clear();
   CHECK(fi2.force_v.force == fi.force_v.force);
   CHECK(fi2.sample_u == fi.sample_u);
   CHECK(fi2.sample_p == fi.sample_p);

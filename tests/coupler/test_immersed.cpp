@@ -392,10 +392,25 @@ TEST_CASE("overlapping bodies: alpha capped at 1, the mean velocity weighted by 
       CHECK(std::abs(fs.velocity[k] - sum_v / both) <= 1e-12);
       capped += both > vol * (1 + 1e-9);
       shared += area[0] > 0 && area[1] > 0;
+      // Marked shared (protocol version 9) exactly where both outlines reach into the box; a
+      // sliver below round-off may go either way.
+      REQUIRE(fs.shared.size() == fs.index.size());
+      const double sliver = 1e-12 * vol;
+      if (std::min(area[0], area[1]) > sliver) CHECK(fs.shared[k] == 1);
+      if (std::min(area[0], area[1]) == 0) CHECK(fs.shared[k] == 0);
     }
     CHECK(capped > 10);  // the overlap covers whole boxes twice: the cap is exercised
     CHECK(shared > capped);
   }
+  // One body alone: no face is shared, and none is sent.
+  proto::BodyMeshes one;
+  one.bodies.push_back(m.bodies[0]);
+  ImmersedSolid alone(g, one);
+  proto::FaceSolid u1, v1;
+  alone.update(at_rest(one), u1, v1);
+  CHECK(!u1.index.empty());
+  CHECK(u1.shared.empty());
+  CHECK(v1.shared.empty());
   // Action = reaction with the overlap.
   std::mt19937 rng(5);
   const auto b = action_plus_reaction(g, is, u, v, rng);
