@@ -226,8 +226,9 @@ void check_checkpoint_version(const std::filesystem::path& out_dir, long step, R
     throw InputError(fmt::format(
         "--restart {}: the checkpoint of step {} was written by a build of protocol version {}, "
         "this build speaks {}: its coupling may differ (version 8: rigid bodies keep the fluid's "
-        "viscosity under fluid.body_viscosity = \"none\"; version 9: the faces two bodies "
-        "share take none of their divergence); run the scene from the start, or "
+        "viscosity under fluid.body_viscosity = \"none\"; version 9: under "
+        "fluid.body_divergence = \"solid\" or \"coupled_step\", cells whose faces name more "
+        "than one body take none of their divergence); run the scene from the start, or "
         "resume with the build that wrote the checkpoint (scene {})",
         out_dir.string(), step,
         version ? std::to_string(version) : "none recorded (a build before this check)",

@@ -51,13 +51,13 @@ void get_list(Reader& r, std::vector<std::vector<T>>& l) {
   for (auto& v : l) r.get(v);
 }
 void put(Writer& w, const FaceSolid& f) {
-  w.put(f.index), w.put(f.alpha), w.put(f.velocity), w.put(f.elastic), w.put(f.shared);
+  w.put(f.index), w.put(f.alpha), w.put(f.velocity), w.put(f.elastic), w.put(f.body);
 }
 void get(Reader& r, FaceSolid& f) {
-  r.get(f.index), r.get(f.alpha), r.get(f.velocity), r.get(f.elastic), r.get(f.shared);
+  r.get(f.index), r.get(f.alpha), r.get(f.velocity), r.get(f.elastic), r.get(f.body);
   if (f.alpha.size() != f.index.size() || f.velocity.size() != f.index.size() ||
       (!f.elastic.empty() && f.elastic.size() != f.index.size()) ||
-      (!f.shared.empty() && f.shared.size() != f.index.size()))
+      (!f.body.empty() && f.body.size() != f.index.size()))
     fail("protocol error: face solid arrays of different lengths");
 }
 void put(Writer& w, const FaceForce& f) { w.put(f.index), w.put(f.force); }
@@ -138,11 +138,11 @@ void FluidInput::unpack(Reader& r) {
   for (const FaceSolid* f : {&solid_u, &solid_v})
     if (some && f->elastic.size() != f->index.size())
       fail("protocol error: the elastic part of alpha sent for some faces only");
-  // So are the shared marks.
-  const bool marked = !solid_u.shared.empty() || !solid_v.shared.empty();
+  // So are the faces' bodies.
+  const bool marked = !solid_u.body.empty() || !solid_v.body.empty();
   for (const FaceSolid* f : {&solid_u, &solid_v})
-    if (marked && f->shared.size() != f->index.size())
-      fail("protocol error: the shared marks sent for some faces only");
+    if (marked && f->body.size() != f->index.size())
+      fail("protocol error: the faces' bodies sent for some faces only");
 }
 
 void FluidOutput::pack(Writer& w) const {

@@ -220,17 +220,18 @@ struct StepBegin {  // coupler -> each solver, every step
 // version 8, elastic: the part of alpha that belongs to elastic bodies (kind 0, not rigid), in
 // the same order, which is where the fluid takes its viscosity out of the bodies
 // (fluid.body_viscosity = "none"); empty in both families when every body of the scene is
-// elastic (then it is alpha), else one value per face in both. Since version 9, shared: 1 for a
-// face whose control volume holds pieces of more than one body (its velocity is the mean over
-// them, whose divergence is their approach, not a volume change: fluid.body_divergence takes
-// none there), else 0; empty in both families when no face of either is shared, else one value
-// per face in both.
+// elastic (then it is alpha), else one value per face in both. Since version 9, body: the index
+// of the one body whose pieces are in the face's control volume, or -1 where pieces of more than
+// one body are (its velocity is their mean, whose divergence is their approach, not a volume
+// change: fluid.body_divergence takes a body's divergence only in cells whose four faces name
+// the same body); empty in both families when the scene has one body, else one value per face
+// in both.
 struct FaceSolid {
   std::vector<std::int32_t> index;
   std::vector<double> alpha;
   std::vector<double> velocity;
   std::vector<double> elastic;
-  std::vector<std::int32_t> shared;
+  std::vector<std::int32_t> body;
 };
 
 // A sparse body force per unit volume on faces (force on the fluid).

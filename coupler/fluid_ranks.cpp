@@ -71,9 +71,9 @@ void FluidRanks::split(const proto::FluidInput& in) {
     split_values(s.alpha, m_rank[comp], alpha);
     split_values(s.velocity, m_rank[comp], vel);
     split_values(s.elastic, m_rank[comp], elastic);  // empty stays empty on every rank
-    std::vector<std::vector<std::int32_t>*> shared(P);
-    for (int r = 0; r < P; ++r) shared[r] = &parts[r]->shared;
-    split_values(s.shared, m_rank[comp], shared);  // likewise
+    std::vector<std::vector<std::int32_t>*> body(P);
+    for (int r = 0; r < P; ++r) body[r] = &parts[r]->body;
+    split_values(s.body, m_rank[comp], body);  // likewise
     // The fibers' force: no answer, its ranks are not kept.
     const proto::FaceForce& f = comp == 0 ? in.force_u : in.force_v;
     std::vector<int> frank;

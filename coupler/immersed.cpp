@@ -330,11 +330,14 @@ void ImmersedSolid::index_fixed(Fixed& f, Scratch& s) {
   touched_faces(f.raw, slot, f.face);
   for (std::size_t k = 0; k < f.face.size(); ++k) slot[f.face[k]] = static_cast<std::int32_t>(k);
   f.area.assign(f.face.size(), 0.0);
+  f.body.assign(f.face.size(), kUnseen);
   f.local.resize(f.raw.size());
   for (std::size_t e = 0; e < f.raw.size(); ++e) {
     const Piece& q = f.raw[e];
     f.local[e] = slot[q.face];
     f.area[f.local[e]] += q.area();
+    std::int32_t& b = f.body[f.local[e]];
+    b = b == kUnseen || b == q.body ? q.body : kSeveral;
   }
   for (const std::int32_t face : f.face) slot[face] = -1;
 }
@@ -372,20 +375,17 @@ void ImmersedSolid::gather(const Fixed& fixed, const Raw& moving, Faces& p, Scra
     for (std::size_t e = 0; e < moving.size(); ++e)
       if (deforms(moving[e].body)) p.elastic_area[p.slot_moving[e]] += moving[e].area();
   }
-  // Faces that pieces of two bodies cover: there ū_s is the mean of two bodies' velocities,
-  // whose divergence is their approach, not a volume change (FaceSolid::shared).
-  p.shared.clear();
-  p.any_shared = false;
+  // The body on each face, kSeveral where pieces of two or more cover it: there ū_s is the mean
+  // of their velocities, whose divergence is their approach, not a volume change
+  // (FaceSolid::body). The fixed faces' bodies were found once (index_fixed).
+  p.body.clear();
   if (m_meshes.bodies.size() > 1) {
-    p.shared.assign(nf, 0);
-    auto& owner = p.sum;  // scratch: the first body seen on each face, -1 before
-    owner.assign(nf, -1.0);
-    auto mark = [&](std::int32_t k, int body) {
-      if (owner[k] < 0) owner[k] = body;
-      else if (owner[k] != body) p.shared[k] = 1, p.any_shared = true;
+    p.body.assign(nf, kUnseen);
+    auto mark = [&](std::int32_t k, std::int32_t b) {
+      std::int32_t& o = p.body[k];
+      o = o == kUnseen || o == b ? b : kSeveral;
     };
-    for (std::size_t e = 0; e < fixed.raw.size(); ++e)
-      mark(p.slot_fixed_face[fixed.local[e]], fixed.raw[e].body);
+    for (std::size_t m = 0; m < fixed.face.size(); ++m) mark(p.slot_fixed_face[m], fixed.body[m]);
     for (std::size_t e = 0; e < moving.size(); ++e) mark(p.slot_moving[e], moving[e].body);
   }
   p.total_area = 0;
@@ -474,10 +474,9 @@ void ImmersedSolid::update(const proto::SolidState& state, proto::FaceSolid& u, 
     family(m_vf, m_fixed_v, m_raw_v, m_v, m_scratch_v, 1, v);
   }
   m_fixed_done = true;
-  // Sent for every face of both families, or for none when no face is shared.
-  const bool any = m_u.any_shared || m_v.any_shared;
-  u.shared = any ? m_u.shared : std::vector<std::int32_t>{};
-  v.shared = any ? m_v.shared : std::vector<std::int32_t>{};
+  // Sent for every face of both families when the scene has more than one body, else for none.
+  u.body = m_u.body;
+  v.body = m_v.body;
 }
 
 void ImmersedSolid::update_velocities(const proto::SolidState& state, proto::FaceSolid& u,

@@ -104,7 +104,9 @@ class ImmersedSolid {
   // and reused.
   void update(const proto::SolidState& state, proto::FaceSolid& u, proto::FaceSolid& v);
   // The same faces and α as the last update(), ū_s from the velocities of `state` (whose positions
-  // must be those of that update): the coupled iterations change only the velocities.
+  // must be those of that update): the coupled iterations change only the velocities. The
+  // faces' bodies (FaceSolid::body) are left as that update() set them in `u`, `v`: pass the
+  // same objects.
   void update_velocities(const proto::SolidState& state, proto::FaceSolid& u,
                          proto::FaceSolid& v) const;
 
@@ -140,7 +142,9 @@ class ImmersedSolid {
     Raw raw;
     std::vector<std::int32_t> face, local;
     std::vector<double> area;
+    std::vector<std::int32_t> body;  // per face: the one fixed body on it, kSeveral for more
   };
+  static constexpr std::int32_t kSeveral = -1, kUnseen = -2;  // FaceSolid::body's marks
   // The touched faces of one family (sorted by index), the slot of each moving piece's face and
   // of each fixed face: per-face sums are then one pass over the pieces into slot-indexed
   // arrays, with no reordering of the pieces.
@@ -148,10 +152,9 @@ class ImmersedSolid {
     std::vector<std::int32_t> face;
     std::vector<double> area;            // Σ |V ∩ T| of the face
     std::vector<double> elastic_area;    // the same over elastic bodies' T (m_any_rigid only)
-    // 1 where pieces of more than one body cover the face (its ū_s their mean), else 0; empty
-    // with one body. any_shared: some face is.
-    std::vector<std::int32_t> shared;
-    bool any_shared = false;
+    // The one body whose pieces cover the face, kSeveral where pieces of more than one do (its
+    // ū_s is their mean); empty with one body (FaceSolid::body).
+    std::vector<std::int32_t> body;
     std::vector<std::int32_t> slot_moving;
     std::vector<std::int32_t> slot_fixed_face;  // per face of Fixed::face
     const Fixed* fixed = nullptr;

@@ -124,8 +124,8 @@ void FluidProgram::advance(const fsi::proto::StepBegin& s, const fsi::proto::Flu
   c.solid_v_velocity = in.solid_v.velocity;
   c.solid_u_elastic = in.solid_u.elastic;
   c.solid_v_elastic = in.solid_v.elastic;
-  c.solid_u_shared = in.solid_u.shared;
-  c.solid_v_shared = in.solid_v.shared;
+  c.solid_u_body = in.solid_u.body;
+  c.solid_v_body = in.solid_v.body;
   c.fiber_u_index = in.force_u.index;
   c.fiber_u_force = in.force_u.force;
   c.fiber_v_index = in.force_v.index;

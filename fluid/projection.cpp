@@ -84,31 +84,46 @@ void Solver::dilating_cells(const CouplingIn& in) {
     for (int c = 0; c < 2; ++c) {
       m_dil_alpha[c] = Field(nx + 1 - c, ny + c, lo, hi);
       m_dil_us[c] = Field(nx + 1 - c, ny + c, lo, hi);
+      m_dil_body[c] = Field(nx + 1 - c, ny + c, lo, hi);
     }
-  // A face that two bodies cover counts as uncovered here: its ū_s is their mean, and the
-  // divergence of two bodies' velocities where they meet is their approach, not a volume change
-  // (taken as one, it made a sink at the vocal folds' closing glottis: fluid/README.md). So a
-  // cell with such a face has φ_c = 0.
-  const std::span<const std::int32_t> shared[2] = {in.solid_u_shared, in.solid_v_shared};
+  // With several bodies, a cell takes a divergence only when its four faces name one body: a
+  // face that pieces of two cover carries their mean velocity, and a cell whose faces name two
+  // bodies spans the gap between them; either way D ū_s there is the bodies' approach, not a
+  // volume change (taken as one, it made a sink at the vocal folds' closing glottis:
+  // fluid/README.md). m_dil_body holds body + 1 (0: several).
+  const std::span<const std::int32_t> body[2] = {in.solid_u_body, in.solid_v_body};
+  // (Whether the scene has several: a rank without faces has no list, and the halo below is
+  // collective.)
+  bool bodies = !body[0].empty() || !body[1].empty();
+  if (!m_dec.serial()) bodies = m_dec.sum(bodies ? 1.0 : 0.0) > 0;
   for (int c = 0; c < 2; ++c)
     for (std::size_t q = 0; q < idx[c].size(); ++q)
       if (alpha[c][q] > 0) {
         const auto [i, j] = face_of(c, idx[c][q]);
-        m_dil_alpha[c](i, j) = !shared[c].empty() && shared[c][q] ? 0.0 : std::min(1.0, alpha[c][q]);
+        m_dil_alpha[c](i, j) = std::min(1.0, alpha[c][q]);
         m_dil_us[c](i, j) = vel[c][q];
+        if (!body[c].empty()) m_dil_body[c](i, j) = body[c][q] + 1.0;
       }
   Field &au = m_dil_alpha[0], &av = m_dil_alpha[1], &us = m_dil_us[0], &vs = m_dil_us[1];
+  Field &bu = m_dil_body[0], &bv = m_dil_body[1];
   // The v faces of row hi (the next slab's first, or across a periodic y); the duplicate faces
   // of a periodic direction carry face 0's values.
-  if (!m_dec.serial()) m_dec.halo(av), m_dec.halo(vs);
+  if (!m_dec.serial()) {
+    m_dec.halo(av), m_dec.halo(vs);
+    if (bodies) m_dec.halo(bv);
+  }
   if (m_grid.x().periodic())
-    for (int j = lo; j < hi; ++j) au(nx, j) = au(0, j), us(nx, j) = us(0, j);
+    for (int j = lo; j < hi; ++j) au(nx, j) = au(0, j), us(nx, j) = us(0, j), bu(nx, j) = bu(0, j);
   if (m_grid.y().periodic() && m_dec.serial())
-    for (int i = 0; i < nx; ++i) av(i, ny) = av(i, 0), vs(i, ny) = vs(i, 0);
+    for (int i = 0; i < nx; ++i) av(i, ny) = av(i, 0), vs(i, ny) = vs(i, 0), bv(i, ny) = bv(i, 0);
   // Each cell with φ > 0 has its west u face among the solid faces; D ū_s from its four faces.
   for (std::size_t q = 0; q < idx[0].size(); ++q) {
     const auto [i, j] = face_of(0, idx[0][q]);
     if (i >= nx || !(alpha[0][q] > 0)) continue;
+    if (bodies) {
+      const double b = bu(i, j);
+      if (!(b > 0 && bu(i + 1, j) == b && bv(i, j) == b && bv(i, j + 1) == b)) continue;
+    }
     const double phi = std::min(std::min(au(i, j), au(i + 1, j)), std::min(av(i, j), av(i, j + 1)));
     if (phi > 0)
       m_dilating.push_back(
@@ -118,10 +133,11 @@ void Solver::dilating_cells(const CouplingIn& in) {
   for (int c = 0; c < 2; ++c)
     for (std::size_t q = 0; q < idx[c].size(); ++q) {
       const auto [i, j] = face_of(c, idx[c][q]);
-      m_dil_alpha[c](i, j) = m_dil_us[c](i, j) = 0;
+      m_dil_alpha[c](i, j) = m_dil_us[c](i, j) = m_dil_body[c](i, j) = 0;
     }
-  for (int j = lo; j < hi; ++j) au(nx, j) = us(nx, j) = 0;
-  for (int i = -1; i <= nx; ++i) av(i, hi) = av(i, lo - 1) = vs(i, hi) = vs(i, lo - 1) = 0;
+  for (int j = lo; j < hi; ++j) au(nx, j) = us(nx, j) = bu(nx, j) = 0;
+  for (int i = -1; i <= nx; ++i)
+    av(i, hi) = av(i, lo - 1) = vs(i, hi) = vs(i, lo - 1) = bv(i, hi) = bv(i, lo - 1) = 0;
   // In row order, so that the sums below do not depend on the input's order or the ranks.
   std::sort(m_dilating.begin(), m_dilating.end(), [](const DilatingCell& x, const DilatingCell& y) {
     return x.j != y.j ? x.j < y.j : x.i < y.i;

@@ -44,8 +44,9 @@ struct CouplingIn {
   // The part of alpha that belongs to elastic bodies, in the same order, where body_viscosity =
   // "none" takes the viscosity out; empty when every body is elastic (then alpha).
   std::span<const double> solid_u_elastic, solid_v_elastic;
-  // 1 on faces that more than one body covers (their ū_s a mean over bodies); empty: none.
-  std::span<const std::int32_t> solid_u_shared, solid_v_shared;
+  // The one body on each face, -1 where several are (its ū_s a mean over them); empty with one
+  // body in the scene.
+  std::span<const std::int32_t> solid_u_body, solid_v_body;
   std::span<const std::int32_t> fiber_u_index, fiber_v_index;
   std::span<const double> fiber_u_force, fiber_v_force;
   std::span<const std::int32_t> sample_u_index, sample_v_index;
@@ -268,7 +269,7 @@ class Solver {
   // set for the step's substep count by end_substeps (dilation_share, projection.cpp).
   double m_dilation_share = 0;
   double dilation_share(int substeps) const;  // projection.cpp
-  std::array<Field, 2> m_dil_alpha, m_dil_us;
+  std::array<Field, 2> m_dil_alpha, m_dil_us, m_dil_body;  // m_dil_body: body + 1, 0 for several
   std::vector<double> m_dil_rows;
   Field m_div_allowed;
   Timings m_time;

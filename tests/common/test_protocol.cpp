@@ -76,18 +76,18 @@ TEST_CASE("every message survives a round trip") {
   const auto fi3 = round_trip(fi);
   CHECK(fi3.solid_u.elastic.empty());
   CHECK(fi3.solid_v.elastic.empty());
-  CHECK(fi3.solid_u.shared.empty());
-  // Faces two bodies cover (version 9): marks on every face of both families.
-  fi.solid_u.shared = {0, 1, 0};
-  fi.solid_v.shared = {0};
+  CHECK(fi3.solid_u.body.empty());
+  // The faces' bodies (version 9): on every face of both families.
+  fi.solid_u.body = {0, -1, 1};
+  fi.solid_v.body = {1};
   const auto fi4 = round_trip(fi);
-  CHECK(fi4.solid_u.shared == fi.solid_u.shared);
-  CHECK(fi4.solid_v.shared == fi.solid_v.shared);
-  fi.solid_v.shared.clear();
+  CHECK(fi4.solid_u.body == fi.solid_u.body);
+  CHECK(fi4.solid_v.body == fi.solid_v.body);
+  fi.solid_v.body.clear();
   FluidInput back;
   CHECK_THROWS_WITH(unpack_message(pack_message(fi, 1), back),
-                    Catch::Contains("shared marks sent for some faces only"));
-  fi.solid_u.shared.clear();
+                    Catch::Contains("faces' bodies sent for some faces only"));
+  fi.solid_u.body.clear();
   CHECK(fi2.force_v.force == fi.force_v.force);
   CHECK(fi2.sample_u == fi.sample_u);
   CHECK(fi2.sample_p == fi.sample_p);

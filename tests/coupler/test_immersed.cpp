@@ -392,25 +392,40 @@ TEST_CASE("overlapping bodies: alpha capped at 1, the mean velocity weighted by 
       CHECK(std::abs(fs.velocity[k] - sum_v / both) <= 1e-12);
       capped += both > vol * (1 + 1e-9);
       shared += area[0] > 0 && area[1] > 0;
-      // Marked shared (protocol version 9) exactly where both outlines reach into the box; a
-      // sliver below round-off may go either way.
-      REQUIRE(fs.shared.size() == fs.index.size());
+      // The face's body (protocol version 9): -1 exactly where both outlines reach into the box,
+      // else the one that does; a sliver below round-off may go either way.
+      REQUIRE(fs.body.size() == fs.index.size());
       const double sliver = 1e-12 * vol;
-      if (std::min(area[0], area[1]) > sliver) CHECK(fs.shared[k] == 1);
-      if (std::min(area[0], area[1]) == 0) CHECK(fs.shared[k] == 0);
+      if (std::min(area[0], area[1]) > sliver) CHECK(fs.body[k] == -1);
+      if (area[1] == 0) CHECK(fs.body[k] == 0);
+      if (area[0] == 0) CHECK(fs.body[k] == 1);
     }
     CHECK(capped > 10);  // the overlap covers whole boxes twice: the cap is exercised
     CHECK(shared > capped);
   }
-  // One body alone: no face is shared, and none is sent.
+  // One body alone: no bodies are sent.
   proto::BodyMeshes one;
   one.bodies.push_back(m.bodies[0]);
   ImmersedSolid alone(g, one);
   proto::FaceSolid u1, v1;
   alone.update(at_rest(one), u1, v1);
   CHECK(!u1.index.empty());
-  CHECK(u1.shared.empty());
-  CHECK(v1.shared.empty());
+  CHECK(u1.body.empty());
+  CHECK(v1.body.empty());
+  // The second body fixed (its faces' bodies found once, when it is first clipped), and the
+  // velocities refilled for a coupled iteration: the same names.
+  proto::BodyMeshes with_fixed = m;
+  with_fixed.bodies[1].kind = proto::BodyKind::rigid_fixed;
+  ImmersedSolid fixed_is(g, with_fixed);
+  proto::FaceSolid uf, vf;
+  const auto rest = at_rest(with_fixed);
+  fixed_is.update(rest, uf, vf);
+  CHECK(uf.body == u.body);
+  CHECK(vf.body == v.body);
+  fixed_is.update(rest, uf, vf);  // the fixed body's pieces kept from the first step
+  CHECK(uf.body == u.body);
+  fixed_is.update_velocities(rest, uf, vf);
+  CHECK(vf.body == v.body);
   // Action = reaction with the overlap.
   std::mt19937 rng(5);
   const auto b = action_plus_reaction(g, is, u, v, rng);

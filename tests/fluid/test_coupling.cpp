@@ -624,8 +624,9 @@ struct Dilating {
   double div_sum = 0;                    // sum of D u |c| over the grid
   double health = 0;                     // max_divergence (the allowed part taken out)
 };
-// `last`: the last step's substep count when not `substeps`; `shared_row`: the faces of this
-// row of the block marked as covered by two bodies (protocol version 9), none when < 0.
+// `last`: the last step's substep count when not `substeps`; `shared_row` >= 0: the block's
+// faces named as of body 0 (protocol version 9), those of this row as of several bodies (-1),
+// or with `shared_row` = 100 the faces of rows 4 and above as of body 1.
 Dilating dilating_block(Config::BodyDivergence mode, BcType sides, int steps, int substeps = 1,
                         int last = 0, int shared_row = -1) {
   const double dt = 1e-3, eps = 0.4, xc = 0.5, yc = 0.25;
@@ -650,12 +651,15 @@ Dilating dilating_block(Config::BodyDivergence mode, BcType sides, int steps, in
       }
     }
   CouplingIn in = solid_input(idx[0], a[0], w[0], idx[1], a[1], w[1]);
-  std::vector<std::int32_t> shared[2];
+  std::vector<std::int32_t> body[2];
   if (shared_row >= 0) {
     for (int c = 0; c < 2; ++c)
-      for (const std::int32_t f : idx[c]) shared[c].push_back(f / (c == 0 ? g.nu() : g.nx()) == shared_row);
-    in.solid_u_shared = shared[0];
-    in.solid_v_shared = shared[1];
+      for (const std::int32_t f : idx[c]) {
+        const int row = f / (c == 0 ? g.nu() : g.nx());
+        body[c].push_back(shared_row == 100 ? (row >= 4 ? 1 : 0) : row == shared_row ? -1 : 0);
+      }
+    in.solid_u_body = body[0];
+    in.solid_v_body = body[1];
   }
   CouplingOut out;
   Dilating r;
@@ -743,18 +747,29 @@ TEST_CASE("body_divergence: coupled_step keeps a plain step's pressure under sub
     CHECK(shared.health <= 1e-9);
     CHECK(shared.health_after <= 1e-9);
   }
-  // Faces two bodies share (row 3 of the block's faces: the u faces of cell row 3, the v faces
-  // between rows 2 and 3): no share in the cells they bound (rows 2 and 3), the others keep it.
-  {
-    const Dilating marked = dilating_block(BD::coupled_step, BcType::pressure, 12, 2, 0, 3);
+  // Faces of several bodies (row 3 of the block's faces: the u faces of cell row 3, the v
+  // faces between rows 2 and 3): no share in the cells they bound (rows 2 and 3), the others
+  // keep it. Two bodies, the faces of rows >= 4 of the second: the cells of row 3, whose north
+  // face is the second body's and the others the first's, span the two and take none.
+  for (const int rows : {3, 100}) {
+    CAPTURE(rows);
+    const Dilating marked = dilating_block(BD::coupled_step, BcType::pressure, 12, 2, 0, rows);
     REQUIRE(marked.div_inside.size() == 24);
     for (std::size_t q = 0; q < 24; ++q) {
       const int row = 2 + int(q) / 6;  // the block's cells, row by row from j = 2
+      const bool none = rows == 3 ? row == 2 || row == 3 : row == 3;
       CAPTURE(q, row);
-      CHECK(std::abs(marked.div_inside[q] - (row == 2 || row == 3 ? 0.0 : 0.75 * 0.8)) <= 1e-9);
+      CHECK(std::abs(marked.div_inside[q] - (none ? 0.0 : 0.75 * 0.8)) <= 1e-9);
     }
     CHECK(marked.div_outside <= 1e-9);
     CHECK(marked.health <= 1e-9);
+  }
+  // "zero" does not look at the faces' bodies: the same bits with and without them.
+  {
+    const Dilating plain_zero = dilating_block(BD::zero, BcType::pressure, 12, 2);
+    const Dilating named_zero = dilating_block(BD::zero, BcType::pressure, 12, 2, 0, 3);
+    CHECK(plain_zero.dp == named_zero.dp);
+    CHECK(plain_zero.div_inside == named_zero.div_inside);
   }
   // After sub-cycled steps a plain one is "zero" again: the block held divergence-free.
   const Dilating after = dilating_block(BD::coupled_step, BcType::pressure, 12, 2, 1);
