@@ -84,7 +84,9 @@ def same_defaults(folder):
     Crank-Nicolson since "increment" became its default; before, "after_solve"); and, with
     rigid bodies under body_viscosity = "none", a build of protocol version 8 or later
     (summary.json; since version 8 "none" leaves rigid bodies their viscosity; runs before it
-    record no version; a run without a summary yet is not judged on it)."""
+    record no version; a run without a summary yet is not judged on it); with several bodies
+    under body_divergence = "solid" or "coupled_step", version 9 or later (since version 9 a
+    cell whose faces name more than one body takes no divergence)."""
     path = os.path.join(folder, "scene.effective.toml")
     if not os.path.exists(path):
         return True
@@ -102,6 +104,18 @@ def same_defaults(folder):
             pass
         except (ValueError, AttributeError):
             return False
+    def version_below(v):
+        try:
+            with open(os.path.join(folder, "summary.json")) as f:
+                return json.load(f).get("protocol_version", 0) < v
+        except OSError:
+            return False
+        except (ValueError, AttributeError):
+            return True
+
+    dilating = re.search(r'^body_divergence\s*=\s*"(solid|coupled_step)"', text, re.M)
+    if dilating and len(re.findall(r'^\[\[solid\.body\]\]', text, re.M)) > 1 and version_below(9):
+        return False
     crank_nicolson = re.search(r'^diffusion\s*=\s*"implicit"', text, re.M) is not None
     return "body_viscosity" in text and (not crank_nicolson or "implicit_forcing" in text)
 
