@@ -93,18 +93,8 @@ def same_defaults(folder):
     text = open(path).read()
     if "[fluid]" not in text:
         return True
-    # (a key at a line's start, or inside an inline table)
-    rigid = re.search(r'(^|[{,])\s*(kind\s*=\s*"rigid"|program\s*=\s*"solid-rigid")', text, re.M)
-    if rigid and re.search(r'^body_viscosity\s*=\s*"none"', text, re.M):
-        try:
-            with open(os.path.join(folder, "summary.json")) as f:
-                if json.load(f).get("protocol_version", 0) < 8:
-                    return False
-        except OSError:
-            pass
-        except (ValueError, AttributeError):
-            return False
     def version_below(v):
+        """Whether summary.json says a build before protocol version v (none yet: not judged)."""
         try:
             with open(os.path.join(folder, "summary.json")) as f:
                 return json.load(f).get("protocol_version", 0) < v
@@ -113,6 +103,10 @@ def same_defaults(folder):
         except (ValueError, AttributeError):
             return True
 
+    # (a key at a line's start, or inside an inline table)
+    rigid = re.search(r'(^|[{,])\s*(kind\s*=\s*"rigid"|program\s*=\s*"solid-rigid")', text, re.M)
+    if rigid and re.search(r'^body_viscosity\s*=\s*"none"', text, re.M) and version_below(8):
+        return False
     dilating = re.search(r'^body_divergence\s*=\s*"(solid|coupled_step)"', text, re.M)
     if dilating and len(re.findall(r'^\[\[solid\.body\]\]', text, re.M)) > 1 and version_below(9):
         return False

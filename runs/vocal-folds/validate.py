@@ -180,13 +180,6 @@ bodies = ["upper"]
 """, 1)
     if ARGS.dt is not None and fluid:
         text = text.replace("dt = 5e-5", f"dt = {ARGS.dt!r}")
-    if p_sub is not None and ARGS.body_divergence is None:
-        # The pressure inlet keeps the fluid's pressure in the compressible folds at one coupled
-        # step's whatever the substeps: under "zero" each substep adds it again and, at the
-        # paper's step, feeds the folds until the run stops (README.md, "What stops the
-        # pressure inlet"; fluid/README.md, body_divergence).
-        text = text.replace("viscosity = 6.666666666666667e-4",
-                            'viscosity = 6.666666666666667e-4\nbody_divergence = "coupled_step"')
     if ARGS.checkpoint_interval is not None and fluid:
         text = text.replace("[output]\n", f"[output]\ncheckpoint_interval = {ARGS.checkpoint_interval!r}\n", 1)
     if ARGS.substeps and fluid:
@@ -226,9 +219,14 @@ bodies = ["upper"]
     if ARGS.body_viscosity is not None and fluid:
         text = text.replace("viscosity = 6.666666666666667e-4",
                             f'viscosity = 6.666666666666667e-4\nbody_viscosity = "{ARGS.body_viscosity}"')
-    if ARGS.body_divergence is not None and fluid:
+    # The pressure inlet keeps the fluid's pressure in the compressible folds at one coupled
+    # step's whatever the substeps: under "zero" each substep adds it again and, at the paper's
+    # step, feeds the folds until the run stops (README.md, "What stops the pressure inlet";
+    # fluid/README.md, body_divergence).
+    divergence = ARGS.body_divergence or ("coupled_step" if p_sub is not None else None)
+    if divergence is not None and fluid:
         text = text.replace("viscosity = 6.666666666666667e-4",
-                            f'viscosity = 6.666666666666667e-4\nbody_divergence = "{ARGS.body_divergence}"')
+                            f'viscosity = 6.666666666666667e-4\nbody_divergence = "{divergence}"')
     return text
 
 
