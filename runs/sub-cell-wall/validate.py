@@ -17,8 +17,9 @@ and 0.128, 0.5, 2 with Crank-Nicolson, its forcing after the solve (the default 
 increment ([fluid] implicit_forcing = "increment"; also at 4, 6 and 8 with the factored solve);
 and at lambda = 0.02 the smoothed footprint ([coupler] footprint_smoothing = 1) as well.
 
-For each lambda the largest offset |e - y0| / h is judged against the tolerance in TOL_OFFSET
-(README.md: what was measured, and why that margin); the largest gain (change of the wall seen
+For each case the largest offset |e - y0| / h is judged against the tolerance in TOL_OFFSET
+(TOL_OFFSET_SMOOTHED for the smoothed footprint; README.md: what was measured, and why that
+margin); the largest gain (change of the wall seen
 over change of the true wall, between successive delta; 1 for a wall placed in proportion) is
 reported.
 Environment: FSI_BIN, FSI_OUT, FSI_ROOT; FSI_MPIRUN (default mpirun)."""
@@ -132,8 +133,8 @@ def main():
                     (f"-{helmholtz}" if helmholtz == "factored" else "") +
                     (f"-smoothed-{smoothing:g}" if smoothing else ""))
             yc, u, wall = run(name, scene(name, y0, lam, diffusion, forcing, helmholtz, smoothing))
-            # Rows the block does not touch, away from the cut row (a smoothed weight reaches a
-            # face up to (1 + smoothing) h/2 from the block).
+            # Rows away from the block and the cut row: more than (1 + smoothing) h above the
+            # block, twice the smoothed weight's reach, as one cell is for the box.
             free = yc > y0 + (1 + smoothing) * H
             slope, icpt = np.polyfit(yc[free], u[free], 1)
             e = -icpt / slope
