@@ -12,6 +12,9 @@ and the bar (fluid.grid.y_band), against the uniform grids (bands.json; about 12
 `--forcing-time TAU`: fluid.forcing_time = TAU in the scenes (the forcing's slip in cut faces
 set by TAU instead of dt; fluid/forcing.cpp); runs and the --bands-xy JSON named *-tauTAU.
 `--xy-levels K`, `--cases cfd1 ...`: --bands-xy on the first K levels, those cases only.
+`--xy-shift S ...`: --bands-xy with both bands moved by these fractions of their spacing (the
+cylinder stays, so its outline meets the cells elsewhere): the forces against the cells'
+alignment (bands_xy_shift.json, runs named *-shiftS).
 `--cost`: error against CPU time of what those wrote (cost.md, cost.png; runs nothing).
 `--reuse`: keep a run whose folder in FSI_OUT has a summary.json from the identical scene text.
 `--helmholtz direct|factored`: fluid.helmholtz in the scenes (factored by default: the key is
@@ -58,6 +61,8 @@ _p.add_argument("--forcing-time", type=float, default=None, metavar="TAU",
                 help="fluid.forcing_time of the scenes (default: not given, tau = dt)")
 _p.add_argument("--xy-levels", type=int, default=None, metavar="K",
                 help="--bands-xy: the first K levels only")
+_p.add_argument("--xy-shift", type=float, nargs="+", default=None, metavar="S",
+                help="--bands-xy: the bands moved by these fractions of their spacing")
 _p.add_argument("--cases", nargs="+", choices=["cfd1", "cfd2"], default=["cfd1", "cfd2"],
                 help="--bands-xy: these cases only")
 _p.add_argument("--helmholtz", choices=["direct", "factored"], default="factored",
@@ -386,41 +391,45 @@ def bands():
 XY_LEVELS = [(0.41 / 246, 600, 123), (0.41 / 328, 760, 152), (0.41 / 410, 920, 184)]
 
 
-def bands_xy(levels=None, dts=None, cases=("cfd1", "cfd2"), out="bands_xy.json"):
+def bands_xy(levels=None, dts=None, cases=("cfd1", "cfd2"), out="bands_xy.json", shifts=(0.0,)):
     """CFD1 and CFD2 with bands in x and y (XY_LEVELS), against the benchmark: error against the
     band's spacing and against wall time (bands_xy.json). `dts`: on each level these time steps
     instead of 0.3 hb s/m (the forcing's slip in partly covered cells grows with dt: README).
-    A run kept by --reuse has the CPU time job.py recorded when it ran (none from before that)."""
+    A run kept by --reuse has the CPU time job.py recorded when it ran (none from before that).
+    `shifts`: the bands moved by these fractions of hb in x and y."""
     rows = []
-    for hb, nx, ny in (levels or XY_LEVELS):
-        xb = (0.1, 0.7, int(round(0.6 / hb)))
-        yb = (0.14, 0.26, int(round(0.12 / hb)))
-        for step in (dts or [round(0.3 * hb, 7)]):
-            tag = f"xy-{nx}x{ny}" + (f"-dt{step:g}" if dts else "")
-            for case in cases:
-                ref = CASES[case]
-                text, dt = scene_text(case, ny, dt=step, band=yb, name=f"{case}-{tag}",
-                                      x_band=xb, columns=nx, lc=hb)
-                folder, wall, cpu = run(f"{case}-{tag}", text)
-                t, fx, fy = forces(folder)
-                d, l = analyse(t, fx, 2.0), analyse(t, fy, 2.0)
-                r = {"case": case, "cells": [nx, ny], "x_band": xb, "y_band": yb, "band_h": hb,
-                     "dt": dt, "forcing_time": ARGS.forcing_time,
-                     "implicit_forcing": FORCING or "increment", "wall_s": wall, "cpu_s": cpu,
-                     "steps": outputs.summary(folder)["steps"],
-                     "drag": d, "lift": l, "drag_error": d["value"] / ref["drag"] - 1.0,
-                     "lift_error": l["value"] / ref["lift"] - 1.0}
-                rows.append(r)
-                print(f"{case} {nx} x {ny}, bands of {1e3 * hb:.3f} mm, dt {dt:g} ({r['steps']} steps, "
-                      f"{wall:.0f} s): drag {d['value']:.4f} ({100 * r['drag_error']:+.2f} %), lift "
-                      f"{l['value']:.4f} ({100 * r['lift_error']:+.2f} %)", flush=True)
-                write_rows(os.path.join(OUT, out.replace(".json", TAU_TAG + ".json")), rows)
+    for (hb, nx, ny), shift, step in [(lv, sh, st) for lv in (levels or XY_LEVELS) for sh in shifts
+                                      for st in (dts or [round(0.3 * lv[0], 7)])]:
+        xb = (0.1 + shift * hb, 0.7 + shift * hb, int(round(0.6 / hb)))
+        yb = (0.14 + shift * hb, 0.26 + shift * hb, int(round(0.12 / hb)))
+        tag = (f"xy-{nx}x{ny}" + (f"-dt{step:g}" if dts else "") +
+               (f"-shift{shift:g}" if shift else ""))
+        for case in cases:
+            ref = CASES[case]
+            text, dt = scene_text(case, ny, dt=step, band=yb, name=f"{case}-{tag}",
+                                  x_band=xb, columns=nx, lc=hb)
+            folder, wall, cpu = run(f"{case}-{tag}", text)
+            t, fx, fy = forces(folder)
+            d, l = analyse(t, fx, 2.0), analyse(t, fy, 2.0)
+            r = {"case": case, "cells": [nx, ny], "x_band": xb, "y_band": yb, "band_h": hb,
+                 "shift": shift,
+                 "dt": dt, "forcing_time": ARGS.forcing_time,
+                 "implicit_forcing": FORCING or "increment", "wall_s": wall, "cpu_s": cpu,
+                 "steps": outputs.summary(folder)["steps"],
+                 "drag": d, "lift": l, "drag_error": d["value"] / ref["drag"] - 1.0,
+                 "lift_error": l["value"] / ref["lift"] - 1.0}
+            rows.append(r)
+            print(f"{case} {nx} x {ny}, bands of {1e3 * hb:.3f} mm"
+                  + (f" moved {shift:g} of a cell" if shift else "") + f", dt {dt:g} ({r['steps']} steps, "
+                  f"{wall:.0f} s): drag {d['value']:.4f} ({100 * r['drag_error']:+.2f} %), lift "
+                  f"{l['value']:.4f} ({100 * r['lift_error']:+.2f} %)", flush=True)
+            write_rows(os.path.join(OUT, out.replace(".json", TAU_TAG + ".json")), rows)
 
 
 def write_rows(path, rows):
-    """rows into the JSON at path, replacing the rows of the same case, grid and dt there and
+    """rows into the JSON at path, replacing the rows of the same case, grid, dt and shift there and
     keeping the others (a run of some levels or cases leaves the rest)."""
-    key = lambda r: (r["case"], tuple(r["cells"]), r["dt"])  # noqa: E731
+    key = lambda r: (r["case"], tuple(r["cells"]), r["dt"], r.get("shift", 0.0))  # noqa: E731
     new = {key(r) for r in rows}
     kept = []
     if os.path.exists(path):
@@ -488,6 +497,9 @@ if __name__ == "__main__":
         bands()
     elif ARGS.cost:
         cost()
+    elif ARGS.bands_xy and ARGS.xy_shift:
+        bands_xy(levels=XY_LEVELS[:ARGS.xy_levels], cases=tuple(ARGS.cases),
+                 out="bands_xy_shift.json", shifts=tuple(ARGS.xy_shift))
     elif ARGS.bands_xy:
         bands_xy(levels=XY_LEVELS[:ARGS.xy_levels], cases=tuple(ARGS.cases))
     elif ARGS.bands_xy_dt:
