@@ -31,6 +31,9 @@ rho_s = 10 rho_f (only the transient differs).
                       levels of the default study
   validate --smoothing FSI2 on L2 with coupler.footprint_smoothing 0, 0.5 and 1: the forces'
                       grid-crossing jitter against their bias (about 6 min)
+  validate --xy-shift S ...  FSI2 on XY82 with both bands moved by these fractions of a cell
+                      (the bodies stay): the results against the cells' alignment (fsi2_shift.json;
+                      with --t-end T to T instead of 12, fsi2_shift-tT.json)
   validate --reuse    keep a run whose folder has a summary.json from the identical scene text
   validate ... --body-viscosity none   every run with [fluid] body_viscosity = "none" (the bar
                       purely elastic, fluid/README.md), outputs under OUT/body-viscosity-none
@@ -66,6 +69,10 @@ _p.add_argument("--fsi1-bands", action="store_true", help="FSI1 on grids with a 
 _p.add_argument("--fsi1-bands-xy", action="store_true", help="FSI1 with bands in x and y")
 _p.add_argument("--smoothing", action="store_true",
                 help="FSI2 on L2 with the footprint smoothed (coupler.footprint_smoothing 0, 0.5, 1)")
+_p.add_argument("--xy-shift", type=float, nargs="+", default=None, metavar="S",
+                help="FSI2 on XY82 with its bands moved by these fractions of a cell")
+_p.add_argument("--t-end", type=float, default=None, metavar="T",
+                help="--xy-shift: run to T instead of 12 (runs named *-tT)")
 _p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
 cli.body_viscosity(_p, "every run")
 ARGS = _p.parse_args()
@@ -136,8 +143,14 @@ WINDOW = 2.0
 TOL = {"amplitude": 0.05, "frequency": 0.03}
 
 
-def scene_text(case, level, dt=None, rho_s=None, t_end=None, smoothing=None):
-    lv = LEVELS[level]
+def scene_text(case, level, dt=None, rho_s=None, t_end=None, smoothing=None, shift=0.0):
+    """The committed scene on `level`; `shift`: its bands moved by that fraction of their
+    spacing (the bodies stay)."""
+    lv = dict(LEVELS[level])
+    for key in ("band", "x_band"):
+        if shift and key in lv:
+            a, b, m = lv[key]
+            lv[key] = (a + shift * (b - a) / m, b + shift * (b - a) / m, m)
     n = lv["n"]
     # A level with a y band keeps the columns (and the cylinder's mesh) of its `nx_rows` uniform
     # rows and lays its n rows out with the band (fluid/README.md, fluid.grid.y_band).
@@ -147,7 +160,7 @@ def scene_text(case, level, dt=None, rho_s=None, t_end=None, smoothing=None):
     dt = lv["dt"] if dt is None else dt
     t_end = T_END if t_end is None else t_end
     replace = {
-        "name": f'name = "{case}-{level}"',
+        "name": f'name = "{case}-{level}{f"-shift{shift:g}" if shift else ""}"',
         "cells": f"cells = [{nx}, {n}]" + (
             "\ny_band = {{ from = {:g}, to = {:g}, cells = {} }}".format(*lv["band"])
             if "band" in lv else "") + (
@@ -415,6 +428,45 @@ def jitter(hist, q, window=WINDOW):
     return float(np.sqrt(np.mean(r[tt >= tt[-1] - window] ** 2)))
 
 
+def study_row(folder, wall, label):
+    """One run of a study: (its histories, its row: `label`, the wall time, the results with the
+    10 ms averages, the jitter, the errors against the 2006 table), and its line printed."""
+    hist = histories(folder)
+    res = {q: analyse(*hist[q]) for q in hist}
+    r = dict(label, wall_s=wall, results=res,
+             jitter_rms={q: jitter(hist, q) for q in ("drag", "lift")}, errors={})
+    add_smoothed(hist, res)
+    for _, q, _ in QUANTITIES:
+        ref = REF[("fsi2", q)]
+        r["errors"][q] = {"mean": rel(res[q]["mean"], ref["mean"]),
+                          "amplitude": rel(res[q]["amplitude"], ref["amplitude"]),
+                          "frequency": rel(res[q]["frequency"], ref["frequency"])}
+    e = r["errors"]
+    print(f"FSI2 {', '.join(f'{k} {v:g}' for k, v in label.items())} ({wall:.0f} s): u_y(A) "
+          f"amplitude {100 * e['uy']['amplitude']:+.1f} % [{res['uy']['frequency']:.3f}], u_x(A) "
+          f"mean {100 * e['ux']['mean']:+.1f} %; drag "
+          f"{res['drag']['mean']:.1f} +- {res['drag']['amplitude']:.1f} (mean "
+          f"{100 * e['drag']['mean']:+.1f} %, amp {100 * e['drag']['amplitude']:+.1f} %; 10 ms "
+          f"average {res['drag_smoothed']['mean']:.1f} +- {res['drag_smoothed']['amplitude']:.1f}); "
+          f"lift amp {res['lift']['amplitude']:.1f} ({100 * e['lift']['amplitude']:+.1f} %; "
+          f"average {res['lift_smoothed']['amplitude']:.1f}); jitter rms drag "
+          f"{r['jitter_rms']['drag']:.2f}, lift {r['jitter_rms']['lift']:.2f}", flush=True)
+    return hist, r
+
+
+def shift_study(shifts):
+    """FSI2 on XY82 with both bands moved by each fraction s of their spacing (the bodies stay):
+    the results against the cells' alignment (fsi2_shift.json). s = 0 is the XY82 level."""
+    rows, t_end = [], ARGS.t_end or T_END
+    tag = f"-t{t_end:g}" if ARGS.t_end else ""
+    for s in shifts:
+        folder, wall, _ = run(f"fsi2-XY82{f'-shift{s:g}' if s else ''}{tag}",
+                              scene_text("fsi2", "XY82", shift=s, t_end=t_end))
+        rows.append(study_row(folder, wall, {"shift": s, "t_end": t_end})[1])
+        with open(os.path.join(OUT, f"fsi2_shift{tag}.json"), "w") as f:
+            json.dump(rows, f, indent=2)
+
+
 def smoothing_study():
     """FSI2 on L2 with the footprint smoothed by eps = 0 (the box, the case's default), 0.5 and 1
     (coupler/README.md, "Smoothed footprint"): the jitter of the forces against their bias."""
@@ -423,25 +475,8 @@ def smoothing_study():
     for eps in (0.0, 0.5, 1.0):
         folder, wall, _ = run(f"fsi2-L2-smoothing-{eps:g}",
                               scene_text("fsi2", "L2", smoothing=eps if eps > 0 else None))
-        hist = histories(folder)
-        res = {q: analyse(*hist[q]) for q in hist}
-        r = {"smoothing": eps, "wall_s": wall, "results": res,
-             "jitter_rms": {q: jitter(hist, q) for q in ("drag", "lift")}, "errors": {}}
-        add_smoothed(hist, res)
-        for _, q, _ in QUANTITIES:
-            ref = REF[("fsi2", q)]
-            r["errors"][q] = {"mean": rel(res[q]["mean"], ref["mean"]),
-                              "amplitude": rel(res[q]["amplitude"], ref["amplitude"])}
+        hist, r = study_row(folder, wall, {"smoothing": eps})
         rows.append(r)
-        e = r["errors"]
-        print(f"FSI2 L2, footprint_smoothing {eps:g} ({wall:.0f} s): u_y(A) amplitude "
-              f"{100 * e['uy']['amplitude']:+.1f} %, u_x(A) mean {100 * e['ux']['mean']:+.1f} %; drag "
-              f"{res['drag']['mean']:.1f} +- {res['drag']['amplitude']:.1f} (mean "
-              f"{100 * e['drag']['mean']:+.1f} %, amp {100 * e['drag']['amplitude']:+.1f} %; 10 ms "
-              f"average {res['drag_smoothed']['mean']:.1f} +- {res['drag_smoothed']['amplitude']:.1f}); "
-              f"lift amp {res['lift']['amplitude']:.1f} ({100 * e['lift']['amplitude']:+.1f} %; "
-              f"average {res['lift_smoothed']['amplitude']:.1f}); jitter rms drag "
-              f"{r['jitter_rms']['drag']:.2f}, lift {r['jitter_rms']['lift']:.2f}", flush=True)
         for ax, q in ((ax1, "drag"), (ax2, "lift")):
             t, y = hist[q]
             w = (t >= 11.0) & (t <= 11.3)
@@ -609,6 +644,9 @@ def main():
         return
     if ARGS.smoothing:
         smoothing_study()
+        return
+    if ARGS.xy_shift:
+        shift_study(ARGS.xy_shift)
         return
     metrics, rows, extra = {}, [], {}
     if not ARGS.fsi1_only:
