@@ -70,6 +70,8 @@ _p.add_argument("--helmholtz", choices=["direct", "factored"], default="factored
 cli.body_viscosity(_p, "the scenes")
 cli.implicit_forcing(_p, "the scenes")
 ARGS = _p.parse_args()
+if ARGS.xy_shift and not ARGS.bands_xy:
+    _p.error("--xy-shift goes with --bands-xy")
 if ARGS.forcing_time is not None and not ARGS.bands_xy:
     _p.error("--forcing-time goes with --bands-xy (the other modes' files are not named by it)")
 SHORT, REUSE = ARGS.short, ARGS.reuse
@@ -400,8 +402,9 @@ def bands_xy(levels=None, dts=None, cases=("cfd1", "cfd2"), out="bands_xy.json",
     rows = []
     for (hb, nx, ny), shift, step in [(lv, sh, st) for lv in (levels or XY_LEVELS) for sh in shifts
                                       for st in (dts or [round(0.3 * lv[0], 7)])]:
-        xb = (0.1 + shift * hb, 0.7 + shift * hb, int(round(0.6 / hb)))
-        yb = (0.14 + shift * hb, 0.26 + shift * hb, int(round(0.12 / hb)))
+        # The band ends as the scene writes them ({:g}, scene_text).
+        xb = (float(f"{0.1 + shift * hb:g}"), float(f"{0.7 + shift * hb:g}"), int(round(0.6 / hb)))
+        yb = (float(f"{0.14 + shift * hb:g}"), float(f"{0.26 + shift * hb:g}"), int(round(0.12 / hb)))
         tag = (f"xy-{nx}x{ny}" + (f"-dt{step:g}" if dts else "") +
                (f"-shift{shift:g}" if shift else ""))
         for case in cases:
@@ -435,7 +438,8 @@ def write_rows(path, rows):
     if os.path.exists(path):
         with open(path) as f:
             kept = [r for r in json.load(f) if key(r) not in new]
-    merged = sorted(kept + rows, key=lambda r: (r["case"], r["cells"][0] * r["cells"][1], -r["dt"]))
+    merged = sorted(kept + rows, key=lambda r: (r["case"], r["cells"][0] * r["cells"][1], -r["dt"],
+                                                 r.get("shift", 0.0)))
     with open(path, "w") as f:
         json.dump(merged, f, indent=2)
 

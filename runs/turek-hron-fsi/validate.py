@@ -33,7 +33,8 @@ rho_s = 10 rho_f (only the transient differs).
                       grid-crossing jitter against their bias (about 6 min)
   validate --xy-shift S ...  FSI2 on XY82 with both bands moved by these fractions of a cell
                       (the bodies stay): the results against the cells' alignment (fsi2_shift.json;
-                      with --t-end T to T instead of 12, fsi2_shift-tT.json)
+                      with --t-end T to T instead of 12, fsi2_shift-tT.json; --shift-level
+                      XY123 on the finer level, fsi2_shift-XY123.json)
   validate --reuse    keep a run whose folder has a summary.json from the identical scene text
   validate ... --body-viscosity none   every run with [fluid] body_viscosity = "none" (the bar
                       purely elastic, fluid/README.md), outputs under OUT/body-viscosity-none
@@ -73,6 +74,8 @@ _p.add_argument("--xy-shift", type=float, nargs="+", default=None, metavar="S",
                 help="FSI2 on XY82 with its bands moved by these fractions of a cell")
 _p.add_argument("--t-end", type=float, default=None, metavar="T",
                 help="--xy-shift: run to T instead of 12 (runs named *-tT)")
+_p.add_argument("--shift-level", choices=["XY82", "XY123"], default="XY82",
+                help="--xy-shift: on this level (default XY82)")
 _p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
 cli.body_viscosity(_p, "every run")
 ARGS = _p.parse_args()
@@ -83,6 +86,8 @@ SHORT = ARGS.short or CI
 REUSE = ARGS.reuse
 COARSE = ARGS.coarse
 BANDS_XY = ARGS.fsi2_bands_xy
+if (ARGS.t_end is not None or ARGS.shift_level != "XY82") and not ARGS.xy_shift:
+    _p.error("--t-end and --shift-level go with --xy-shift")
 if BANDS_XY and (SHORT or COARSE):
     _p.error("--fsi2-bands-xy runs its own levels: not with --short, --ci or --coarse")
 # The study's file names: levels{TAG}.md, summary{TAG}.json and fsi2{TAG with _}_histories.png.
@@ -150,7 +155,8 @@ def scene_text(case, level, dt=None, rho_s=None, t_end=None, smoothing=None, shi
     for key in ("band", "x_band"):
         if shift and key in lv:
             a, b, m = lv[key]
-            lv[key] = (a + shift * (b - a) / m, b + shift * (b - a) / m, m)
+            # the ends as the scene writes them ({:g} below)
+            lv[key] = (float(f"{a + shift * (b - a) / m:g}"), float(f"{b + shift * (b - a) / m:g}"), m)
     n = lv["n"]
     # A level with a y band keeps the columns (and the cylinder's mesh) of its `nx_rows` uniform
     # rows and lays its n rows out with the band (fluid/README.md, fluid.grid.y_band).
@@ -428,9 +434,10 @@ def jitter(hist, q, window=WINDOW):
     return float(np.sqrt(np.mean(r[tt >= tt[-1] - window] ** 2)))
 
 
-def study_row(folder, wall, label):
+def study_row(folder, wall, label, title):
     """One run of a study: (its histories, its row: `label`, the wall time, the results with the
-    10 ms averages, the jitter, the errors against the 2006 table), and its line printed."""
+    10 ms averages, the jitter, the signed errors value / reference − 1 against the 2006 table),
+    and its line printed after `title`."""
     hist = histories(folder)
     res = {q: analyse(*hist[q]) for q in hist}
     r = dict(label, wall_s=wall, results=res,
@@ -438,11 +445,9 @@ def study_row(folder, wall, label):
     add_smoothed(hist, res)
     for _, q, _ in QUANTITIES:
         ref = REF[("fsi2", q)]
-        r["errors"][q] = {"mean": rel(res[q]["mean"], ref["mean"]),
-                          "amplitude": rel(res[q]["amplitude"], ref["amplitude"]),
-                          "frequency": rel(res[q]["frequency"], ref["frequency"])}
+        r["errors"][q] = {k: res[q][k] / ref[k] - 1.0 for k in ("mean", "amplitude", "frequency")}
     e = r["errors"]
-    print(f"FSI2 {', '.join(f'{k} {v:g}' for k, v in label.items())} ({wall:.0f} s): u_y(A) "
+    print(f"{title} ({wall:.0f} s): u_y(A) "
           f"amplitude {100 * e['uy']['amplitude']:+.1f} % [{res['uy']['frequency']:.3f}], u_x(A) "
           f"mean {100 * e['ux']['mean']:+.1f} %; drag "
           f"{res['drag']['mean']:.1f} +- {res['drag']['amplitude']:.1f} (mean "
@@ -454,16 +459,23 @@ def study_row(folder, wall, label):
     return hist, r
 
 
-def shift_study(shifts):
-    """FSI2 on XY82 with both bands moved by each fraction s of their spacing (the bodies stay):
-    the results against the cells' alignment (fsi2_shift.json). s = 0 is the XY82 level."""
-    rows, t_end = [], ARGS.t_end or T_END
-    tag = f"-t{t_end:g}" if ARGS.t_end else ""
+def shift_study(shifts, level):
+    """FSI2 on `level` (XY82 or XY123) with both bands moved by each fraction s of their spacing
+    (the bodies stay): the results against the cells' alignment (fsi2_shift*.json). s = 0 is
+    the level itself."""
+    t_end = ARGS.t_end or T_END
+    path = os.path.join(OUT, "fsi2_shift" + ("" if level == "XY82" else f"-{level}") +
+                        (f"-t{t_end:g}" if ARGS.t_end else "") + ".json")
     for s in shifts:
-        folder, wall, _ = run(f"fsi2-XY82{f'-shift{s:g}' if s else ''}{tag}",
-                              scene_text("fsi2", "XY82", shift=s, t_end=t_end))
-        rows.append(study_row(folder, wall, {"shift": s, "t_end": t_end})[1])
-        with open(os.path.join(OUT, f"fsi2_shift{tag}.json"), "w") as f:
+        folder, wall, _ = run(f"fsi2-{level}{f'-shift{s:g}' if s else ''}"
+                              f"{f'-t{t_end:g}' if ARGS.t_end else ''}",
+                              scene_text("fsi2", level, shift=s, t_end=t_end))
+        row = study_row(folder, wall, {"shift": s, "t_end": t_end},
+                        f"FSI2 {level}, bands moved {s:g} of a cell, to t = {t_end:g}")[1]
+        # Rows of other shifts already in the file stay.
+        rows = json.load(open(path)) if os.path.exists(path) else []
+        rows = sorted([q for q in rows if q["shift"] != s] + [row], key=lambda q: q["shift"])
+        with open(path, "w") as f:
             json.dump(rows, f, indent=2)
 
 
@@ -475,7 +487,7 @@ def smoothing_study():
     for eps in (0.0, 0.5, 1.0):
         folder, wall, _ = run(f"fsi2-L2-smoothing-{eps:g}",
                               scene_text("fsi2", "L2", smoothing=eps if eps > 0 else None))
-        hist, r = study_row(folder, wall, {"smoothing": eps})
+        hist, r = study_row(folder, wall, {"smoothing": eps}, f"FSI2 L2, footprint_smoothing {eps:g}")
         rows.append(r)
         for ax, q in ((ax1, "drag"), (ax2, "lift")):
             t, y = hist[q]
@@ -646,7 +658,7 @@ def main():
         smoothing_study()
         return
     if ARGS.xy_shift:
-        shift_study(ARGS.xy_shift)
+        shift_study(ARGS.xy_shift, ARGS.shift_level)
         return
     metrics, rows, extra = {}, [], {}
     if not ARGS.fsi1_only:
