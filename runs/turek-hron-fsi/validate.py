@@ -31,6 +31,7 @@ rho_s = 10 rho_f (only the transient differs).
                       levels of the default study
   validate --smoothing FSI2 on L2 with coupler.footprint_smoothing 0, 0.5 and 1: the forces'
                       grid-crossing jitter against their bias (about 6 min)
+  validate --fsi1-bands-xy --xy-shift S ...  FSI1 the same way on 600 x 123 (fsi1_bands_xy_shift.json)
   validate --xy-shift S ...  FSI2 on XY82 with both bands moved by these fractions of a cell
                       (the bodies stay): the results against the cells' alignment (fsi2_shift.json;
                       with --t-end T to T instead of 12, fsi2_shift-tT.json; --shift-level
@@ -86,8 +87,9 @@ SHORT = ARGS.short or CI
 REUSE = ARGS.reuse
 COARSE = ARGS.coarse
 BANDS_XY = ARGS.fsi2_bands_xy
-if (ARGS.t_end is not None or ARGS.shift_level != "XY82") and not ARGS.xy_shift:
-    _p.error("--t-end and --shift-level go with --xy-shift")
+if (ARGS.t_end is not None or ARGS.shift_level != "XY82") and (not ARGS.xy_shift or
+                                                                ARGS.fsi1_bands_xy):
+    _p.error("--t-end and --shift-level go with --xy-shift (FSI2), not with --fsi1-bands-xy")
 if BANDS_XY and (SHORT or COARSE):
     _p.error("--fsi2-bands-xy runs its own levels: not with --short, --ci or --coarse")
 # The study's file names: levels{TAG}.md, summary{TAG}.json and fsi2{TAG with _}_histories.png.
@@ -590,25 +592,32 @@ def fsi1_bands_xy():
     """FSI1 (rho_s = 10 rho_f, t = 8, bar 140 x 8, as --fsi1-bands) with bands in x and y at once:
     cells of side hb over x in [0.1, 0.7] and y in [0.14, 0.26] (the cylinder, the bar, its
     tip's neighbourhood), growing outside (the pressure solve transforms y by its eigenvectors);
-    dt below the explicit diffusion limit hb^2 / (8 nu)."""
+    dt below the explicit diffusion limit hb^2 / (8 nu). With --xy-shift S ...: the first level
+    only, its bands moved by each S of a cell, the bodies staying (fsi1_bands_xy_shift.json)."""
     rows = []
-    for hb, nx, ny, dt in [(0.41 / 246, 600, 123, 2.5e-4), (0.41 / 328, 760, 152, 1.5e-4),
-                           (0.41 / 410, 920, 184, 1e-4)]:
+    levels = [(0.41 / 246, 600, 123, 2.5e-4), (0.41 / 328, 760, 152, 1.5e-4),
+              (0.41 / 410, 920, 184, 1e-4)]
+    shifts = ARGS.xy_shift or [0.0]
+    for (hb, nx, ny, dt), shift in [(lv, s) for lv in (levels[:1] if ARGS.xy_shift else levels)
+                                    for s in shifts]:
         level = f"XY{ny}"
         xb = (0.1, 0.7, int(round(0.6 / hb)))
         yb = (0.14, 0.26, int(round(0.12 / hb)))
         LEVELS[level] = {"n": ny, "nx": nx, "lc": hb, "dt": dt, "bar": [140, 8], "band": yb,
                          "x_band": xb}
-        r_job = job.run(f"fsi1-bands-xy-{nx}x{ny}",
-                        scene_text("fsi1", level, rho_s=10000.0, t_end=8.0), reuse=REUSE)
+        r_job = job.run(f"fsi1-bands-xy-{nx}x{ny}" + (f"-shift{shift:g}" if shift else ""),
+                        scene_text("fsi1", level, rho_s=10000.0, t_end=8.0, shift=shift),
+                        reuse=REUSE)
         hist = histories(r_job.folder)
-        r = {"cells": [nx, ny], "x_band": xb, "y_band": yb, "h_band": hb,
+        r = {"cells": [nx, ny], "x_band": xb, "y_band": yb, "h_band": hb, "shift": shift,
              "bar_cells_across": 0.02 / hb, "dt": dt, "wall_s": r_job.wall, "cpu_s": r_job.cpu}
         r.update(steady_values(hist))
         r["tip_deflection_in_cells"] = r["uy"]["value"] / hb
         rows.append(r)
-        print_steady(f"FSI1 on {nx} x {ny}, bands of {1e3 * hb:.3f} mm", r, r_job.wall)
-        with open(os.path.join(OUT, "fsi1_bands_xy.json"), "w") as f:
+        print_steady(f"FSI1 on {nx} x {ny}, bands of {1e3 * hb:.3f} mm"
+                     + (f" moved {shift:g} of a cell" if shift else ""), r, r_job.wall)
+        name = "fsi1_bands_xy_shift.json" if ARGS.xy_shift else "fsi1_bands_xy.json"
+        with open(os.path.join(OUT, name), "w") as f:
             json.dump(rows, f, indent=2)
 
 
