@@ -24,6 +24,14 @@ def edit(path, replace, strict=True):
     return "\n".join(lines) + "\n"
 
 
+def shifted_band(band, shift):
+    """A grid band (from, to, cells) moved by `shift` of its spacing, its ends rounded as a
+    scene written with {:g} holds them (so a run's record and its scene agree)."""
+    a, b, m = band
+    d = shift * (b - a) / m
+    return float(f"{a + d:g}"), float(f"{b + d:g}"), m
+
+
 def write_points(folder, name, points):
     """Marker positions for a fiber's shape = "points" in folder/name_points.csv; returns the
     file name (the scene beside it names it)."""

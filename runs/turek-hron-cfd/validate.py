@@ -44,6 +44,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import outputs  # noqa: E402
+import scenes  # noqa: E402
 from metrics import finish, metric, relative, run_entry  # noqa: E402
 
 _p = cli.parser(__doc__)
@@ -402,9 +403,8 @@ def bands_xy(levels=None, dts=None, cases=("cfd1", "cfd2"), out="bands_xy.json",
     rows = []
     for (hb, nx, ny), shift, step in [(lv, sh, st) for lv in (levels or XY_LEVELS) for sh in shifts
                                       for st in (dts or [round(0.3 * lv[0], 7)])]:
-        # The band ends as the scene writes them ({:g}, scene_text).
-        xb = (float(f"{0.1 + shift * hb:g}"), float(f"{0.7 + shift * hb:g}"), int(round(0.6 / hb)))
-        yb = (float(f"{0.14 + shift * hb:g}"), float(f"{0.26 + shift * hb:g}"), int(round(0.12 / hb)))
+        xb = scenes.shifted_band((0.1, 0.7, int(round(0.6 / hb))), shift)
+        yb = scenes.shifted_band((0.14, 0.26, int(round(0.12 / hb))), shift)
         tag = (f"xy-{nx}x{ny}" + (f"-dt{step:g}" if dts else "") +
                (f"-shift{shift:g}" if shift else ""))
         for case in cases:

@@ -55,6 +55,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.tri as mtri  # noqa: E402
 import numpy as np  # noqa: E402
 import outputs  # noqa: E402
+import scenes  # noqa: E402
 import solidout  # noqa: E402
 from metrics import finish, metric, reported  # noqa: E402
 
@@ -156,9 +157,7 @@ def scene_text(case, level, dt=None, rho_s=None, t_end=None, smoothing=None, shi
     lv = dict(LEVELS[level])
     for key in ("band", "x_band"):
         if shift and key in lv:
-            a, b, m = lv[key]
-            # the ends as the scene writes them ({:g} below)
-            lv[key] = (float(f"{a + shift * (b - a) / m:g}"), float(f"{b + shift * (b - a) / m:g}"), m)
+            lv[key] = scenes.shifted_band(lv[key], shift)
     n = lv["n"]
     # A level with a y band keeps the columns (and the cylinder's mesh) of its `nx_rows` uniform
     # rows and lays its n rows out with the band (fluid/README.md, fluid.grid.y_band).
