@@ -31,11 +31,13 @@ rho_s = 10 rho_f (only the transient differs).
                       levels of the default study
   validate --smoothing FSI2 on L2 with coupler.footprint_smoothing 0, 0.5 and 1: the forces'
                       grid-crossing jitter against their bias (about 6 min)
-  validate --fsi1-bands-xy --xy-shift S ...  FSI1 the same way on 600 x 123 (fsi1_bands_xy_shift.json)
+  validate --fsi1-bands-xy --xy-shift S ...  FSI1 the same way on 600 x 123 (fsi1_bands_xy_shift.json;
+                      --fsi1-shift-level XY152 or XY184 on a finer level, fsi1_bands_xy_shift-XY184.json)
   validate --xy-shift S ...  FSI2 on XY82 with both bands moved by these fractions of a cell
                       (the bodies stay): the results against the cells' alignment (fsi2_shift.json;
                       with --t-end T to T instead of 12, fsi2_shift-tT.json; --shift-level
-                      XY123 on the finer level, fsi2_shift-XY123.json)
+                      XY123, XY164 or XY246 on a finer level (the bar 6, 8, 12 cells thick),
+                      fsi2_shift-XY123.json)
   validate --reuse    keep a run whose folder has a summary.json from the identical scene text
   validate ... --body-viscosity none   every run with [fluid] body_viscosity = "none" (the bar
                       purely elastic, fluid/README.md), outputs under OUT/body-viscosity-none
@@ -76,8 +78,10 @@ _p.add_argument("--xy-shift", type=float, nargs="+", default=None, metavar="S",
                 help="FSI2 on XY82 with its bands moved by these fractions of a cell")
 _p.add_argument("--t-end", type=float, default=None, metavar="T",
                 help="--xy-shift: run to T instead of 12 (runs named *-tT)")
-_p.add_argument("--shift-level", choices=["XY82", "XY123"], default="XY82",
+_p.add_argument("--shift-level", choices=["XY82", "XY123", "XY164", "XY246"], default="XY82",
                 help="--xy-shift: on this level (default XY82)")
+_p.add_argument("--fsi1-shift-level", choices=["XY123", "XY152", "XY184"], default="XY123",
+                help="--fsi1-bands-xy --xy-shift: on this level (default XY123)")
 _p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
 cli.body_viscosity(_p, "every run")
 ARGS = _p.parse_args()
@@ -91,6 +95,8 @@ BANDS_XY = ARGS.fsi2_bands_xy
 if (ARGS.t_end is not None or ARGS.shift_level != "XY82") and (not ARGS.xy_shift or
                                                                 ARGS.fsi1_bands_xy):
     _p.error("--t-end and --shift-level go with --xy-shift (FSI2), not with --fsi1-bands-xy")
+if ARGS.fsi1_shift_level != "XY123" and not (ARGS.xy_shift and ARGS.fsi1_bands_xy):
+    _p.error("--fsi1-shift-level goes with --fsi1-bands-xy --xy-shift")
 if BANDS_XY and (SHORT or COARSE):
     _p.error("--fsi2-bands-xy runs its own levels: not with --short, --ci or --coarse")
 # The study's file names: levels{TAG}.md, summary{TAG}.json and fsi2{TAG with _}_histories.png.
@@ -128,8 +134,12 @@ LEVELS = {
 # FSI2 with bands in x and y (--fsi2-bands-xy): L2's and L4's cells (h = 0.41/82, 0.41/123) and
 # bars over x in [0.1, 0.9] (the cylinder, the bar, two bar lengths of its wake) and y in
 # [0.1, 0.31] (the tip sweeps 0.12 ... 0.28), growing outside by the ratio the counts give
-# (1.03 ... 1.05); the bar's faces on grid lines as on the uniform levels.
-for _n, _nx, _ny, _dt, _bar in ((82, 255, 70, 5e-4, [140, 8]), (123, 353, 99, 2.5e-4, [210, 12])):
+# (1.03 ... 1.05); the bar's faces on grid lines as on the uniform levels. XY164 and XY246 (the
+# bar 8 and 12 cells thick; --shift-level) continue the refinement with the same growth ratios,
+# bar elements half a cell and dt / h as on XY82 and XY123.
+for _n, _nx, _ny, _dt, _bar in ((82, 255, 70, 5e-4, [140, 8]), (123, 353, 99, 2.5e-4, [210, 12]),
+                                (164, 446, 128, 2.5e-4, [280, 16]),
+                                (246, 627, 182, 1.25e-4, [420, 24])):
     _h = H / _n
     LEVELS[f"XY{_n}"] = {"n": _ny, "nx": _nx, "lc": _h, "dt": _dt, "bar": _bar,
                          "x_band": (0.1, 0.9, int(round(0.8 / _h))),
@@ -461,7 +471,7 @@ def study_row(folder, wall, label, title):
 
 
 def shift_study(shifts, level):
-    """FSI2 on `level` (XY82 or XY123) with both bands moved by each fraction s of their spacing
+    """FSI2 on `level` (XY82 ... XY246) with both bands moved by each fraction s of their spacing
     (the bodies stay): the results against the cells' alignment (fsi2_shift*.json). s = 0 is
     the level itself."""
     t_end = ARGS.t_end or T_END
@@ -473,11 +483,30 @@ def shift_study(shifts, level):
                               scene_text("fsi2", level, shift=s, t_end=t_end))
         row = study_row(folder, wall, {"shift": s, "t_end": t_end},
                         f"FSI2 {level}, bands moved {s:g} of a cell, to t = {t_end:g}")[1]
-        # Rows of other shifts already in the file stay.
-        rows = json.load(open(path)) if os.path.exists(path) else []
-        rows = sorted([q for q in rows if q["shift"] != s] + [row], key=lambda q: q["shift"])
-        with open(path, "w") as f:
-            json.dump(rows, f, indent=2)
+        merge_shift_row(path, row)
+
+
+def merge_shift_row(path, row):
+    """Add `row` to the shift study's file at `path`, replacing the row of its shift (the rows of
+    other shifts already there stay, sorted by shift); returns the rows."""
+    rows = json.load(open(path)) if os.path.exists(path) else []
+    rows = sorted([q for q in rows if q["shift"] != row["shift"]] + [row], key=lambda q: q["shift"])
+    with open(path, "w") as f:
+        json.dump(rows, f, indent=2)
+    return rows
+
+
+def print_alignment_mean(title, rows, errors):
+    """The signed errors of a steady shift study averaged over the alignments in its file, with
+    their range: a body placed anywhere in its cells meets the mean on average and the range at
+    worst. errors: (name, row -> signed error) pairs. (Not for FSI2: whether its flapping has
+    saturated by t_end depends on the shift, README.)"""
+    shifts = ", ".join(f"{r['shift']:g}" for r in rows)
+    parts = []
+    for name, err in errors:
+        e = [100 * err(r) for r in rows]
+        parts.append(f"{name} {np.mean(e):+.1f} % ({min(e):+.1f} ... {max(e):+.1f})")
+    print(f"{title}, mean over the shifts {shifts}: " + "; ".join(parts), flush=True)
 
 
 def smoothing_study():
@@ -592,13 +621,15 @@ def fsi1_bands_xy():
     cells of side hb over x in [0.1, 0.7] and y in [0.14, 0.26] (the cylinder, the bar, its
     tip's neighbourhood), growing outside (the pressure solve transforms y by its eigenvectors);
     dt below the explicit diffusion limit hb^2 / (8 nu). With --xy-shift S ...: the first level
-    only, its bands moved by each S of a cell, the bodies staying (fsi1_bands_xy_shift.json)."""
+    only (--fsi1-shift-level: another), its bands moved by each S of a cell, the bodies staying
+    (fsi1_bands_xy_shift.json, fsi1_bands_xy_shift-XY184.json)."""
     rows = []
     levels = [(0.41 / 246, 600, 123, 2.5e-4), (0.41 / 328, 760, 152, 1.5e-4),
               (0.41 / 410, 920, 184, 1e-4)]
     shifts = ARGS.xy_shift or [0.0]
-    for (hb, nx, ny, dt), shift in [(lv, s) for lv in (levels[:1] if ARGS.xy_shift else levels)
-                                    for s in shifts]:
+    if ARGS.xy_shift:
+        levels = [lv for lv in levels if f"XY{lv[2]}" == ARGS.fsi1_shift_level]
+    for (hb, nx, ny, dt), shift in [(lv, s) for lv in levels for s in shifts]:
         level = f"XY{ny}"
         xb = (0.1, 0.7, int(round(0.6 / hb)))
         yb = (0.14, 0.26, int(round(0.12 / hb)))
@@ -615,9 +646,16 @@ def fsi1_bands_xy():
         rows.append(r)
         print_steady(f"FSI1 on {nx} x {ny}, bands of {1e3 * hb:.3f} mm"
                      + (f" moved {shift:g} of a cell" if shift else ""), r, r_job.wall)
-        name = "fsi1_bands_xy_shift.json" if ARGS.xy_shift else "fsi1_bands_xy.json"
-        with open(os.path.join(OUT, name), "w") as f:
-            json.dump(rows, f, indent=2)
+        if ARGS.xy_shift:
+            path = os.path.join(OUT, "fsi1_bands_xy_shift" + ("" if level == "XY123" else f"-{level}")
+                                + ".json")
+            shift_rows = merge_shift_row(path, r)
+        else:
+            with open(os.path.join(OUT, "fsi1_bands_xy.json"), "w") as f:
+                json.dump(rows, f, indent=2)
+    if ARGS.xy_shift:
+        print_alignment_mean(f"FSI1 {ARGS.fsi1_shift_level}", shift_rows,
+                             [(q, lambda r, q=q: r[q]["error"]) for q in ("uy", "ux", "lift", "drag")])
 
 
 def write_levels(rows):
