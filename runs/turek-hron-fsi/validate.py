@@ -32,12 +32,13 @@ rho_s = 10 rho_f (only the transient differs).
   validate --smoothing FSI2 on L2 with coupler.footprint_smoothing 0, 0.5 and 1: the forces'
                       grid-crossing jitter against their bias (about 6 min)
   validate --fsi1-bands-xy --xy-shift S ...  FSI1 the same way on 600 x 123 (fsi1_bands_xy_shift.json;
-                      --fsi1-shift-level XY152 or XY184 on a finer level, fsi1_bands_xy_shift-XY184.json)
+                      --fsi1-shift-level XY152 or XY184: on 760 x 152 or 920 x 184,
+                      fsi1_bands_xy_shift-LEVEL.json)
   validate --xy-shift S ...  FSI2 on XY82 with both bands moved by these fractions of a cell
                       (the bodies stay): the results against the cells' alignment (fsi2_shift.json;
                       with --t-end T to T instead of 12, fsi2_shift-tT.json; --shift-level
-                      XY123, XY164 or XY246 on a finer level (the bar 6, 8, 12 cells thick),
-                      fsi2_shift-XY123.json)
+                      XY123, XY164 or XY246 on a finer level (353 x 99, 446 x 128, 627 x 182:
+                      the bar 6, 8, 12 cells thick), fsi2_shift-LEVEL[-tT].json)
   validate --reuse    keep a run whose folder has a summary.json from the identical scene text
   validate ... --body-viscosity none   every run with [fluid] body_viscosity = "none" (the bar
                       purely elastic, fluid/README.md), outputs under OUT/body-viscosity-none
@@ -80,8 +81,9 @@ _p.add_argument("--t-end", type=float, default=None, metavar="T",
                 help="--xy-shift: run to T instead of 12 (runs named *-tT)")
 _p.add_argument("--shift-level", choices=["XY82", "XY123", "XY164", "XY246"], default="XY82",
                 help="--xy-shift: on this level (default XY82)")
-_p.add_argument("--fsi1-shift-level", choices=["XY123", "XY152", "XY184"], default="XY123",
-                help="--fsi1-bands-xy --xy-shift: on this level (default XY123)")
+_p.add_argument("--fsi1-shift-level", choices=["XY123", "XY152", "XY184"], default=None,
+                help="--fsi1-bands-xy --xy-shift: on this level, named by its rows (600 x 123, "
+                     "760 x 152, 920 x 184; default XY123)")
 _p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
 cli.body_viscosity(_p, "every run")
 ARGS = _p.parse_args()
@@ -95,8 +97,9 @@ BANDS_XY = ARGS.fsi2_bands_xy
 if (ARGS.t_end is not None or ARGS.shift_level != "XY82") and (not ARGS.xy_shift or
                                                                 ARGS.fsi1_bands_xy):
     _p.error("--t-end and --shift-level go with --xy-shift (FSI2), not with --fsi1-bands-xy")
-if ARGS.fsi1_shift_level != "XY123" and not (ARGS.xy_shift and ARGS.fsi1_bands_xy):
+if ARGS.fsi1_shift_level is not None and not (ARGS.xy_shift and ARGS.fsi1_bands_xy):
     _p.error("--fsi1-shift-level goes with --fsi1-bands-xy --xy-shift")
+FSI1_SHIFT_LEVEL = ARGS.fsi1_shift_level or "XY123"
 if BANDS_XY and (SHORT or COARSE):
     _p.error("--fsi2-bands-xy runs its own levels: not with --short, --ci or --coarse")
 # The study's file names: levels{TAG}.md, summary{TAG}.json and fsi2{TAG with _}_histories.png.
@@ -136,7 +139,8 @@ LEVELS = {
 # [0.1, 0.31] (the tip sweeps 0.12 ... 0.28), growing outside by the ratio the counts give
 # (1.03 ... 1.05); the bar's faces on grid lines as on the uniform levels. XY164 and XY246 (the
 # bar 8 and 12 cells thick; --shift-level) continue the refinement with the same growth ratios,
-# bar elements half a cell and dt / h as on XY82 and XY123.
+# bar elements half a cell and dt / h as on XY82 and XY123 respectively (0.1, 0.075). These FSI2
+# levels are named by h = 0.41/n; fsi1_bands_xy() names its grids by their rows.
 for _n, _nx, _ny, _dt, _bar in ((82, 255, 70, 5e-4, [140, 8]), (123, 353, 99, 2.5e-4, [210, 12]),
                                 (164, 446, 128, 2.5e-4, [280, 16]),
                                 (246, 627, 182, 1.25e-4, [420, 24])):
@@ -498,9 +502,9 @@ def merge_shift_row(path, row):
 
 def print_alignment_mean(title, rows, errors):
     """The signed errors of a steady shift study averaged over the alignments in its file, with
-    their range: a body placed anywhere in its cells meets the mean on average and the range at
-    worst. errors: (name, row -> signed error) pairs. (Not for FSI2: whether its flapping has
-    saturated by t_end depends on the shift, README.)"""
+    their range over those shifts (a body placed anywhere in its cells meets the mean on average).
+    errors: (name, row -> signed error) pairs. Not for FSI2: whether its flapping has settled by
+    t_end depends on the shift (README)."""
     shifts = ", ".join(f"{r['shift']:g}" for r in rows)
     parts = []
     for name, err in errors:
@@ -628,7 +632,7 @@ def fsi1_bands_xy():
               (0.41 / 410, 920, 184, 1e-4)]
     shifts = ARGS.xy_shift or [0.0]
     if ARGS.xy_shift:
-        levels = [lv for lv in levels if f"XY{lv[2]}" == ARGS.fsi1_shift_level]
+        levels = [lv for lv in levels if f"XY{lv[2]}" == FSI1_SHIFT_LEVEL]
     for (hb, nx, ny, dt), shift in [(lv, s) for lv in levels for s in shifts]:
         level = f"XY{ny}"
         xb = (0.1, 0.7, int(round(0.6 / hb)))
@@ -654,7 +658,7 @@ def fsi1_bands_xy():
             with open(os.path.join(OUT, "fsi1_bands_xy.json"), "w") as f:
                 json.dump(rows, f, indent=2)
     if ARGS.xy_shift:
-        print_alignment_mean(f"FSI1 {ARGS.fsi1_shift_level}", shift_rows,
+        print_alignment_mean(f"FSI1 {FSI1_SHIFT_LEVEL}", shift_rows,
                              [(q, lambda r, q=q: r[q]["error"]) for q in ("uy", "ux", "lift", "drag")])
 
 
