@@ -626,7 +626,7 @@ def fsi1_bands_xy():
     tip's neighbourhood), growing outside (the pressure solve transforms y by its eigenvectors);
     dt below the explicit diffusion limit hb^2 / (8 nu). With --xy-shift S ...: the first level
     only (--fsi1-shift-level: another), its bands moved by each S of a cell, the bodies staying
-    (fsi1_bands_xy_shift.json, fsi1_bands_xy_shift-XY184.json)."""
+    (fsi1_bands_xy_shift.json on 600 x 123, fsi1_bands_xy_shift-LEVEL.json on the others)."""
     rows = []
     levels = [(0.41 / 246, 600, 123, 2.5e-4), (0.41 / 328, 760, 152, 1.5e-4),
               (0.41 / 410, 920, 184, 1e-4)]
