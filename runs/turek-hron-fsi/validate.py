@@ -479,8 +479,7 @@ def shift_study(shifts, level):
     (the bodies stay): the results against the cells' alignment (fsi2_shift*.json). s = 0 is
     the level itself."""
     t_end = ARGS.t_end or T_END
-    path = os.path.join(OUT, "fsi2_shift" + ("" if level == "XY82" else f"-{level}") +
-                        (f"-t{t_end:g}" if ARGS.t_end else "") + ".json")
+    path = shift_file("fsi2_shift", level, "XY82", f"-t{t_end:g}" if ARGS.t_end else "")
     for s in shifts:
         folder, wall, _ = run(f"fsi2-{level}{f'-shift{s:g}' if s else ''}"
                               f"{f'-t{t_end:g}' if ARGS.t_end else ''}",
@@ -488,6 +487,12 @@ def shift_study(shifts, level):
         row = study_row(folder, wall, {"shift": s, "t_end": t_end},
                         f"FSI2 {level}, bands moved {s:g} of a cell, to t = {t_end:g}")[1]
         merge_shift_row(path, row)
+
+
+def shift_file(stem, level, default_level, suffix=""):
+    """A shift study's file in OUT: stem, then -LEVEL unless the study's default level, then
+    suffix."""
+    return os.path.join(OUT, stem + ("" if level == default_level else f"-{level}") + suffix + ".json")
 
 
 def merge_shift_row(path, row):
@@ -651,9 +656,7 @@ def fsi1_bands_xy():
         print_steady(f"FSI1 on {nx} x {ny}, bands of {1e3 * hb:.3f} mm"
                      + (f" moved {shift:g} of a cell" if shift else ""), r, r_job.wall)
         if ARGS.xy_shift:
-            path = os.path.join(OUT, "fsi1_bands_xy_shift" + ("" if level == "XY123" else f"-{level}")
-                                + ".json")
-            shift_rows = merge_shift_row(path, r)
+            shift_rows = merge_shift_row(shift_file("fsi1_bands_xy_shift", level, "XY123"), r)
         else:
             with open(os.path.join(OUT, "fsi1_bands_xy.json"), "w") as f:
                 json.dump(rows, f, indent=2)
