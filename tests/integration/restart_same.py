@@ -14,8 +14,9 @@ through; the stopped run is
 Before the restart, a newer checkpoint folder that not every program completed is planted (a
 crash while writing): the restart must pass it by. With --change 'OLD=>NEW' a restart of the
 scene with that text replaced must first be refused with an error naming --key. With
---older-version the checkpoint's files are first marked as written by protocol version 7: the
-restart must be refused naming it (then the marks are put back).
+--older-version copies of the checkpoint are first marked as written by older builds (the
+fluid's file without a version; then the other programs' as version 7), one copy each: each
+restart must be refused naming the version, the copy left as it was.
 --effective resumes with the scene.effective.toml the stopped run wrote (its t_end made T, put
 beside the scene): the scene as run, with every program's defaults filled in, is the same scene.
 --fluid-ranks runs the stopped run's fluid on P ranks, --restart-ranks the restart's on Q (the
@@ -114,7 +115,7 @@ def main():
     ap.add_argument("--change", help="'OLD=>NEW': a scene text change the restart must refuse")
     ap.add_argument("--key", help="the key the refusal must name")
     ap.add_argument("--older-version", action="store_true",
-                    help="a checkpoint of protocol version 7 must be refused")
+                    help="checkpoints of older builds (no version, version 7) must be refused")
     ap.add_argument("--fluid-ranks", type=int, default=1, help="the stopped run's fluid ranks")
     ap.add_argument("--restart-ranks", type=int, help="the restart's fluid ranks (default: --fluid-ranks)")
     ap.add_argument("--effective", action="store_true",
@@ -166,31 +167,37 @@ def main():
                          f"(exit {r.returncode}):\n{r.stderr[-2000:]}")
             print(f"restart_same: a restart with {a.change} is refused naming {a.key}")
         if a.older_version:
-            # On a copy of the stopped run, its files marked as written by older builds: the
-            # fluid's without the version (before it was recorded), the others' as version 7.
+            # On copies of the stopped run, files marked as written by older builds: the
+            # fluid's without the version (before it was recorded), then the other programs' as
+            # version 7. Every program checks its own file and the first to refuse ends the job,
+            # so each mark is tried alone: with both at once, which message is printed is a race.
             import h5py
-            older = stopped + "_older"
-            shutil.copytree(stopped, older)
-            step = max(steps_of(older))
-            for p in glob.glob(os.path.join(older, "checkpoint", f"step_{step:08d}", "*.h5")):
-                with h5py.File(p, "r+") as h5:
-                    if os.path.basename(p) == "fluid.h5":
-                        del h5.attrs["protocol_version"]
-                    else:
-                        h5.attrs["protocol_version"] = 7
-            before = snapshot(older)
-            r = subprocess.run(command(a.bin, full, ["--restart", older]), capture_output=True,
-                               text=True, timeout=120)
-            expected = ["protocol version none recorded"]
+            step = max(steps_of(stopped))
+            cases = [("fluid", "protocol version none recorded")]
             if roles_of(a.bin, full) != ["fluid"]:
-                expected.append("protocol version 7,")
-            missing = [e for e in expected if e not in r.stderr]
-            if r.returncode == 0 or missing:
-                sys.exit(f"restart_same: checkpoints of older builds were not refused (exit "
-                         f"{r.returncode}; not said: {missing}):\n{r.stderr[-2000:]}")
-            if snapshot(older) != before:
-                sys.exit("restart_same: the refused restart changed the output folder")
-            shutil.rmtree(older)
+                cases.append(("others", "protocol version 7,"))
+            for marked, expected in cases:
+                older = stopped + "_older"
+                shutil.copytree(stopped, older)
+                for p in glob.glob(os.path.join(older, "checkpoint", f"step_{step:08d}", "*.h5")):
+                    is_fluid = os.path.basename(p) == "fluid.h5"
+                    if is_fluid != (marked == "fluid"):
+                        continue
+                    with h5py.File(p, "r+") as h5:
+                        if is_fluid:
+                            del h5.attrs["protocol_version"]
+                        else:
+                            h5.attrs["protocol_version"] = 7
+                before = snapshot(older)
+                r = subprocess.run(command(a.bin, full, ["--restart", older]), capture_output=True,
+                                   text=True, timeout=120)
+                if r.returncode == 0 or expected not in r.stderr:
+                    sys.exit(f"restart_same: a checkpoint of an older build ({marked} marked) was "
+                             f"not refused saying '{expected}' (exit {r.returncode}):\n"
+                             f"{r.stderr[-2000:]}")
+                if snapshot(older) != before:
+                    sys.exit("restart_same: the refused restart changed the output folder")
+                shutil.rmtree(older)
             print("restart_same: checkpoints of older builds are refused, the output untouched")
         resume = full
         if a.effective:
