@@ -285,9 +285,15 @@ void Solver::solve_contact(const ContactLinearisation& con, double gap_tol, Eige
 }
 
 // Physical contact forces on the nodes, f = m_contact_force_factor lambda B^T of the active
-// slots (force ON each body).
+// slots (force ON each body). A slot between two bodies puts f n on its slave and, through the
+// weights (1 − ξ) + ξ = 1, −f n on its master: their sums over those slots (contact_bodies) are
+// the force of the other bodies alone, without the planes' reactions and self-contact (which
+// sums to zero over a body), equal and opposite for a pair.
 void Solver::store_contact_forces() {
-  for (auto& bp : m_bodies) std::fill(bp->contact.begin(), bp->contact.end(), 0.0);
+  for (auto& bp : m_bodies) {
+    std::fill(bp->contact.begin(), bp->contact.end(), 0.0);
+    bp->contact_bodies = {0, 0};
+  }
   for (const auto& s : m_contact.slots()) {
     if (!s.active) continue;
     const double f = m_contact_force_factor * s.lambda;
@@ -299,6 +305,11 @@ void Solver::store_contact_forces() {
       add(s.master_body, s.m0, s.m1 >= 0 ? -(1 - s.xi) : -1.0);
       if (s.m1 >= 0) add(s.master_body, s.m1, -s.xi);
     }
+    if (s.master_body >= 0 && s.master_body != s.slave_body)
+      for (int i = 0; i < 2; ++i) {
+        m_bodies[s.slave_body]->contact_bodies[i] += f * s.normal[i];
+        m_bodies[s.master_body]->contact_bodies[i] -= f * s.normal[i];
+      }
   }
 }
 

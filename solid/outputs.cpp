@@ -112,6 +112,8 @@ Vec2 Solver::total_contact_force(int b) const {
   return f;
 }
 
+Vec2 Solver::contact_force_from_bodies(int b) const { return m_bodies[b]->contact_bodies; }
+
 double Solver::min_contact_gap() const {
   double g = std::numeric_limits<double>::infinity();
   for (const auto& s : m_contact.slots()) g = std::min(g, s.gap);

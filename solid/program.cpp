@@ -92,6 +92,10 @@ SolidProgram::SolidProgram(fsi::Runtime& rt)
   }
   cols.push_back("coupling_work");
   cols.push_back("contact_work");
+  for (const auto& b : m_cfg.model.bodies) {
+    cols.push_back(b.name + ".contact_bodies_fx");
+    cols.push_back(b.name + ".contact_bodies_fy");
+  }
   m_history.emplace(fsi::output_csv(rt, rt.out_dir() / "solid_history.csv", cols));
   m_external.resize(s.num_bodies());
 }
@@ -364,6 +368,11 @@ void SolidProgram::output(long step, double t, bool fields) {
   }
   h.push_back(m_coupling_work);
   h.push_back(m_contact_work);
+  for (int b = 0; b < s.num_bodies(); ++b) {
+    const Vec2 f = s.contact_force_from_bodies(b);
+    h.push_back(f[0]);
+    h.push_back(f[1]);
+  }
   m_history->write(t, h);
   if (fields) write_fields(step, t);
 }

@@ -194,6 +194,8 @@ class Solver {
   const std::vector<double>& contact_forces(int b) const;
   std::vector<double> contact_pressure(int b) const;
   Vec2 total_contact_force(int b) const;
+  // ... its part from the other bodies (contact pairs; not the planes, not self-contact)
+  Vec2 contact_force_from_bodies(int b) const;
   double min_contact_gap()
       const;  // smallest signed gap over every contact candidate (+inf if none)
 

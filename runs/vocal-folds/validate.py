@@ -23,7 +23,7 @@ central convection stable in the jet), --newmark-gamma 0.5.
   the identical scene already there is used (finished, failed with an ERROR in its log, or still
   running: what it wrote so far), the others are run (--no-run: none is). Per run: point B's
   u_y, its spectrum over t >= 1, the dominant frequency and the nearest eigenfrequency, the
-  amplitude, contact, forces and impulses; spectra.png (Fig. 13), frequency.png,
+  amplitude, contact, forces and impulses; spectra.png and displacement.png (Fig. 13), frequency.png,
   trajectories.png (Fig. 14), forces_h0.png (Fig. 15), fields.png (Fig. 12); the paper's
   findings reported, only "ran to t_end" judged.
 --clearances H,H,...: the sweep's velocity-inflow runs at these clearances only (and no
@@ -73,9 +73,25 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from metrics import at_most, finish, holds, reported  # noqa: E402
 
+
+
+def clearance(text):
+    """A clearance h/D, for `type=`: the channel is D + h wide, so h > -1. (A negative h > -1
+    makes the folds overlap at t = 0, which the solid refuses naming them and the depth.)"""
+    try:
+        h = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a number, got '{text}'")
+    if not h > -1:
+        raise argparse.ArgumentTypeError(
+            f"the clearance h/D = {text} makes the channel 1 + h = {1 + h:g} D wide, nothing left "
+            f"for the flow between the folds 'lower' and 'upper' (each D/2 high): h must be > -1")
+    return h
+
+
 P = cli.parser(__doc__)
 P.add_argument("--modes", action="store_true", help="eigenmodes of one fold and of the pair")
-P.add_argument("--run", type=float, metavar="H", help="one coupled run at clearance h/D = H")
+P.add_argument("--run", type=clearance, metavar="H", help="one coupled run at clearance h/D = H")
 P.add_argument("--grid", choices=("paper", "coarse"), default="paper", help="grid of --run and --sweep")
 P.add_argument("--t-end", type=cli.positive, default=None,
                help="end time of --run and of --sweep's runs (default 12)")
@@ -93,7 +109,7 @@ P.add_argument("--no-run", action="store_true",
 P.add_argument("--material", choices=("saint-venant-kirchhoff", "neo-hookean"),
                default="neo-hookean",
                help="the folds' material (default neo-hookean; saint-venant-kirchhoff: the paper's)")
-P.add_argument("--clearances", type=lambda s: [float(v) for v in s.split(",")], default=None,
+P.add_argument("--clearances", type=lambda s: [clearance(v) for v in s.split(",")], default=None,
                help="--sweep: only these clearances, velocity inflow")
 P.add_argument("--wall-planes", action=argparse.BooleanOptionalAction, default=True,
                help="a rigid contact plane at each wall, for the fold fixed on it (default: on)")
@@ -542,12 +558,19 @@ def sweep_case(h, p_sub, grid, t_end, upwind, modes_f):
         if active.any():
             row["any_contact_last"] = float(th[active][-1])
         row["min_gap"] = float(np.min(hist["min_gap"]))
-    # Forces on the lower fold and their impulses: the whole run and t >= 1.
+    # Forces on the lower fold and their impulses: the whole run and t >= 1. The contact force is
+    # the upper fold's on it (solid_history.csv's contact_bodies columns); its whole contact force
+    # adds the wall plane's reaction (and self-contact, which sums to zero), kept as
+    # impulse_contact_all. A run written before those columns has the whole force only.
     if hist is not None and forces is not None:
-        row["impulse_contact"] = impulse(hist["time"], hist["lower.contact_fx"], hist["lower.contact_fy"])
+        pair = "lower.contact_bodies_fx" in hist
+        cx, cy = ("lower.contact_bodies_fx", "lower.contact_bodies_fy") if pair else \
+            ("lower.contact_fx", "lower.contact_fy")
+        row["impulse_contact_of"] = "the upper fold" if pair else "all contact (the wall plane's too)"
+        row["impulse_contact"] = impulse(hist["time"], hist[cx], hist[cy])
+        row["impulse_contact_all"] = impulse(hist["time"], hist["lower.contact_fx"], hist["lower.contact_fy"])
         row["impulse_fluid"] = impulse(forces["time"], forces["lower.fx"], forces["lower.fy"])
-        row["impulse_contact_after_settle"] = impulse(hist["time"], hist["lower.contact_fx"],
-                                                      hist["lower.contact_fy"], SETTLE)
+        row["impulse_contact_after_settle"] = impulse(hist["time"], hist[cx], hist[cy], SETTLE)
         row["impulse_fluid_after_settle"] = impulse(forces["time"], forces["lower.fx"], forces["lower.fy"],
                                                     SETTLE)
         # |contact| / |fluid| of the impulse vectors; and of the y components alone (contact
@@ -627,7 +650,8 @@ def draw_field(a, folder, step, time_s, title):
 
 
 def sweep_plots(rows, modes_f, x_ref, shapes):
-    """spectra.png, frequency.png, trajectories.png, forces_h0.png, fields.png into OUT."""
+    """spectra.png, displacement.png, frequency.png, trajectories.png, forces_h0.png, fields.png
+    into OUT."""
     label = {id(r): f"h = {r['h']:g}" + ("" if r["inlet"] == "velocity" else f", {r['inlet']}") for r in rows}
     colours = plt.cm.viridis(np.linspace(0, 0.9, len(rows)))
     f_hi = 3 * modes_f[2]
@@ -653,6 +677,26 @@ def sweep_plots(rows, modes_f, x_ref, shapes):
     a.set_title(f"spectrum of B's u_y over t >= {SETTLE} (Hann window, mean removed)", fontsize=9)
     fig.tight_layout()
     fig.savefig(os.path.join(OUT, "spectra.png"), dpi=120)
+    plt.close(fig)
+    # Fig. 13's other half: B's u_y over time, one panel per run (the spectra's window shaded).
+    fig, ax = plt.subplots(len(rows), 1, figsize=(8, 1.6 * max(len(rows), 1)), squeeze=False,
+                           sharex=True)
+    for j, r in enumerate(rows):
+        a = ax[j, 0]
+        pr = r.get("data", {}).get("probes")
+        if pr is not None:
+            a.plot(pr["time"], pr["B_lower.uy"], color=colours[j], lw=0.5)
+            a.axvspan(SETTLE, pr["time"][-1], color="0.92", lw=0)
+        else:
+            a.text(0.5, 0.5, "no data", ha="center", transform=a.transAxes, fontsize=7)
+        a.set_ylabel("u_y(B)", fontsize=7)
+        a.tick_params(labelsize=7)
+        a.set_title(label[id(r)], fontsize=7, loc="left")
+    ax[-1, 0].set_xlabel("t (D / u_m)")
+    fig.suptitle(f"point B's vertical displacement (shaded: t >= {SETTLE}, the spectra's window)",
+                 fontsize=9)
+    fig.tight_layout()
+    fig.savefig(os.path.join(OUT, "displacement.png"), dpi=120)
     plt.close(fig)
     # The dominant frequency against the clearance.
     fig, a = plt.subplots(figsize=(6, 4))
@@ -728,8 +772,14 @@ def sweep_plots(rows, modes_f, x_ref, shapes):
         for i, c in enumerate(("x", "y")):
             a = ax[i, j]
             a.plot(fo["time"], fo[f"lower.f{c}"], lw=0.6, label=f"fluid, impulse {r['impulse_fluid'][i]:.4g}")
-            a.plot(hs["time"], hs[f"lower.contact_f{c}"], lw=0.6,
-                   label=f"contact, impulse {r['impulse_contact'][i]:.4g}")
+            if f"lower.contact_bodies_f{c}" in hs:
+                a.plot(hs["time"], hs[f"lower.contact_f{c}"], lw=0.4, color="0.6",
+                       label=f"all contact (with the wall plane), impulse {r['impulse_contact_all'][i]:.4g}")
+                a.plot(hs["time"], hs[f"lower.contact_bodies_f{c}"], lw=0.6,
+                       label=f"contact of the upper fold, impulse {r['impulse_contact'][i]:.4g}")
+            else:
+                a.plot(hs["time"], hs[f"lower.contact_f{c}"], lw=0.6,
+                       label=f"all contact (with the wall plane), impulse {r['impulse_contact'][i]:.4g}")
             a.set_xlabel("t")
             a.set_ylabel(f"force on the lower fold, {c}")
             a.set_title(f"{label[id(r)]}: to t = {r['end']:.3f}" + ("" if r["reached"] else f" ({r['state']})"),
@@ -803,9 +853,11 @@ if ARGS.sweep:
             jf, jc = r["impulse_fluid"], r["impulse_contact"]
             ratio = "-" if r["impulse_ratio"] is None else f"{r['impulse_ratio']:.4g}"
             ratio_y = "-" if r["impulse_ratio_y"] is None else f"{r['impulse_ratio_y']:.4g}"
+            ja = r["impulse_contact_all"]
             print(f"h = 0, {r['inlet']}: impulses on the lower fold to t = {r['end']:.3f}: fluid "
-                  f"({jf[0]:.5g}, {jf[1]:.5g}), contact ({jc[0]:.5g}, {jc[1]:.5g}), "
-                  f"|contact| / |fluid| = {ratio} (y alone {ratio_y})")
+                  f"({jf[0]:.5g}, {jf[1]:.5g}), contact of {r['impulse_contact_of']} ({jc[0]:.5g}, "
+                  f"{jc[1]:.5g}), |contact| / |fluid| = {ratio} (y alone {ratio_y}); all contact "
+                  f"({ja[0]:.5g}, {ja[1]:.5g})")
         key = f"sweep_{r['name']}"
         metrics[f"{key}_runs_to_the_end"] = holds(r["reached"])
         if r["end"] is not None:

@@ -72,6 +72,12 @@ TEST_CASE("two blocks pressed together: no penetration, contact force = applied 
         CHECK(std::abs(fc_punch[1] + load[1]) <= 1e-8 * std::abs(load[1]));
         CHECK(std::abs(fc_base[1] - load[1]) <= 1e-8 * std::abs(load[1]));
         CHECK(std::abs(support[1] + load[1]) <= 1e-8 * std::abs(load[1]));
+        // Without planes and self-contact, all of it comes from the other body (summed in
+        // another order: to round-off).
+        for (int b : {0, 1})
+          for (int i : {0, 1})
+            CHECK(std::abs(s.contact_force_from_bodies(b)[i] - s.total_contact_force(b)[i]) <=
+                  1e-12 * std::abs(load[1]));
         // No penetration beyond 1e-8 of the block size (0.5).
         CHECK(s.min_contact_gap() >= -1e-8 * 0.5);
       }
@@ -1112,4 +1118,14 @@ TEST_CASE("a lever takes a node the free step left open through: the working set
   CHECK(s.min_contact_gap() >= -tol);
   CHECK(s.displacements(0)[2 * right + 1] == Approx(-g_plane).margin(1e-9));
   CHECK(s.contact_forces(0)[2 * right + 1] > 0);  // the plane pushes the right end up
+  // The block's part of the lever's contact force leaves the plane's out: what remains of the
+  // total is normal to the plane and pushes up; the block gets the opposite of its part.
+  const Vec2 total = s.total_contact_force(0), bodies = s.contact_force_from_bodies(0);
+  INFO("total (" << total[0] << ", " << total[1] << "), from the block (" << bodies[0] << ", "
+                 << bodies[1] << ")");
+  CHECK(bodies[1] > 0);
+  CHECK(total[1] - bodies[1] > 0.1 * total[1]);
+  CHECK(std::abs(total[0] - bodies[0]) <= 1e-12 * total[1]);
+  CHECK(s.contact_force_from_bodies(1)[0] == -bodies[0]);
+  CHECK(s.contact_force_from_bodies(1)[1] == -bodies[1]);
 }
