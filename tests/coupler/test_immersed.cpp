@@ -202,6 +202,22 @@ std::vector<AreaCase> area_cases() {
   return cases;
 }
 
+// The grid g with both directions stretched, as bands give (finer in the middle, coarser towards
+// the ends): each face moved by s -> s + a sin(2 pi s) / (2 pi) of its direction's span
+// (monotone for a < 1; the ends stay, so a periodic direction keeps its period).
+proto::GridInfo stretched_both(proto::GridInfo g) {
+  auto warp = [](std::vector<double>& f, double a) {
+    const double lo = f.front(), len = f.back() - f.front(), n = double(f.size() - 1);
+    for (std::size_t k = 1; k + 1 < f.size(); ++k) {
+      const double s = k / n;
+      f[k] = lo + len * (s - a * std::sin(2 * M_PI * s) / (2 * M_PI));
+    }
+  };
+  warp(g.x_face, 0.45);
+  warp(g.y_face, 0.6);
+  return g;
+}
+
 }  // namespace
 
 TEST_CASE("volume fractions add up to the body's area, for u- and v-cells separately") {
@@ -220,7 +236,10 @@ TEST_CASE("volume fractions add up to the body's area, for u- and v-cells separa
 }
 
 TEST_CASE("mean solid velocity is the exact mean over CV ∩ body of a linear field") {
-  const auto g = grid(24, 20, 1.2, 1.0, false, false);
+  const auto uniform = grid(24, 20, 1.2, 1.0, false, false);
+  const bool stretched = GENERATE(false, true);
+  INFO((stretched ? "both directions stretched" : "uniform grid"));
+  const auto g = stretched ? stretched_both(uniform) : uniform;
   const double theta = 0.41, w = 0.5, h = 0.35;
   const Vec2 c{0.61, 0.48};
   proto::BodyMeshes m;
@@ -271,7 +290,10 @@ TEST_CASE("mean solid velocity is the exact mean over CV ∩ body of a linear fi
 }
 
 TEST_CASE("the nodal reaction cancels the fluid forcing: action = reaction") {
-  const auto g = grid(32, 32, 1.0, 1.0, true, false);
+  const auto uniform = grid(32, 32, 1.0, 1.0, true, false);
+  const bool stretched = GENERATE(false, true);
+  INFO((stretched ? "both directions stretched" : "uniform grid"));
+  const auto g = stretched ? stretched_both(uniform) : uniform;
   proto::BodyMeshes m;
   m.bodies.push_back(rectangle(0.3, 0.2, 8, 5, 0.3, {0.1, 0.5}));  // crosses x = 0
   double area = 0;
