@@ -82,7 +82,9 @@ ProbeCsv ProbeCsv::resume(const std::filesystem::path& path, std::vector<std::st
     std::string line;
     std::getline(in, line);
     if (strip_cr(line) != csv.header())
-      throw Error(fmt::format("cannot resume probe file {}: its header '{}' differs from '{}'",
+      throw Error(fmt::format("cannot resume probe file {}: its header '{}' differs from '{}' "
+                              "(a build with other columns wrote it): resume with that build, "
+                              "or run the scene again",
                               path.string(), strip_cr(line), csv.header()));
     kept = csv.header() + "\n";
     long number = 1;

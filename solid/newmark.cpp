@@ -180,9 +180,13 @@ StepReport Solver::newmark_span(double dt, const std::vector<std::vector<double>
   restore_state(start);
   StepReport first, rep;
   std::vector<std::vector<double>> contact;
+  std::vector<Vec2> contact_bodies;
   try {
     first = newmark_span(dt / 2, external, when, cutbacks - 1, 2 * parts);
-    for (const auto& b : m_bodies) contact.push_back(b->contact);
+    for (const auto& b : m_bodies) {
+      contact.push_back(b->contact);
+      contact_bodies.push_back(b->contact_bodies);
+    }
     rep = newmark_span(dt / 2, external, when, cutbacks - 1, 2 * parts);
   } catch (const StepFailed&) {
     if (parts == 1) {  // the whole step failed: keep where it started (failed_step_start)
@@ -191,9 +195,12 @@ StepReport Solver::newmark_span(double dt, const std::vector<std::vector<double>
     }
     throw;
   }
-  for (std::size_t b = 0; b < m_bodies.size(); ++b)
+  for (std::size_t b = 0; b < m_bodies.size(); ++b) {
     for (std::size_t d = 0; d < contact[b].size(); ++d)
       m_bodies[b]->contact[d] = 0.5 * (contact[b][d] + m_bodies[b]->contact[d]);
+    for (int i = 0; i < 2; ++i)
+      m_bodies[b]->contact_bodies[i] = 0.5 * (contact_bodies[b][i] + m_bodies[b]->contact_bodies[i]);
+  }
   rep.iterations += first.iterations;
   rep.assembly_seconds += first.assembly_seconds;
   rep.factor_seconds += first.factor_seconds;

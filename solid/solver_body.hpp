@@ -45,7 +45,7 @@ struct Solver::Body {
   std::vector<double> f_ext, q, r;        // last assembly: loads, internal force, residual
   std::vector<double> r_0;                // ... the residual without the coupling force
   std::vector<double> contact;            // contact force on the nodes (physical)
-  Vec2 contact_bodies{0, 0};  // its sum over the pairs with other bodies (no planes, no self-contact)
+  Vec2 contact_bodies{0, 0};  // its sum from the other bodies (no planes, no self-contact)
   std::vector<double> det_f;              // per element, last assembly
   std::vector<double> dirichlet_step;     // pending increment of the prescribed dofs
   std::vector<double> abs_q, abs_floor;   // assembly scratch: scales of the residual

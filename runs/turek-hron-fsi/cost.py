@@ -9,8 +9,8 @@ seconds of the whole job). For each level and alignment s it takes the row of th
 (a window that settled: README, "FSI2 against the cells' alignment"), and computes the errors
 of u_y(A)'s amplitude and of the drag and lift amplitudes (raw and after the 10 ms average)
 against the 2006 table and the refined FEATFLOW values (reference.csv). The cost axis is the
-CPU seconds to the case's t = 12 (a run taken further, to let its window settle, is scaled by
-12 / t_end). Prints one row per run and the mean over the alignments of each level; writes
+CPU seconds to the case's t = 12: of the run to t = 12 where there is one, else of the longer
+run (taken further to let its window settle) scaled by 12 / t_end. Prints one row per run and the mean over the alignments of each level; writes
 cost.json and cost.png (error against CPU seconds, both references) into DIR.
 """
 import argparse
@@ -42,8 +42,10 @@ def reference():
 
 
 def study_rows(out):
-    """{(level, shift): row} with the longest run of each, the row's file and job times added."""
-    best = {}
+    """{(level, shift): row} with the longest run of each, the row's file and job times added;
+    its cost_cpu is the CPU time of the run to the case's t = 12 where there is one (a longer
+    run may have gone beside other work), else its own scaled by 12 / t_end."""
+    best, cpu_to_12 = {}, {}
     for path in sorted(glob.glob(os.path.join(out, "fsi2_shift*.json"))):
         m = re.fullmatch(r"fsi2_shift(?:-(XY\d+))?(?:-t([\d.]+))?\.json", os.path.basename(path))
         if not m:
@@ -61,9 +63,13 @@ def study_rows(out):
                 continue
             jt = json.load(open(times))
             key = (level, row["shift"])
+            if t_end == CASE_T_END:
+                cpu_to_12[key] = jt["cpu_s"]
             if key not in best or t_end > best[key]["t_end"]:
                 best[key] = dict(row, t_end=t_end, level=level, folder=folder,
                                  wall=jt["wall_s"], cpu=jt["cpu_s"])
+    for key, r in best.items():
+        r["cost_cpu"] = cpu_to_12.get(key, r["cpu"] * CASE_T_END / r["t_end"])
     return best
 
 
@@ -82,6 +88,7 @@ def main():
     ap.add_argument("--out", default=os.environ.get("FSI_OUT", os.path.join(HERE, "..", "..", "out",
                                                                            "turek-hron-fsi")))
     a = ap.parse_args()
+    a.out = os.path.abspath(a.out)
     ref = reference()
     rows = study_rows(a.out)
     if not rows:
@@ -90,14 +97,21 @@ def main():
     for (level, s), r in sorted(rows.items(), key=lambda kv: (LEVELS[kv[0][0]][1], kv[0][1])):
         table.append({"level": level, "cells": LEVELS[level][0], "bar_cells": LEVELS[level][1],
                       "shift": s, "t_end": r["t_end"], "wall_s": r["wall"], "cpu_s": r["cpu"],
-                      "cpu_s_to_12": r["cpu"] * CASE_T_END / r["t_end"],
+                      "cpu_s_to_12": r["cost_cpu"],
                       "vs_2006": errors(r, ref["fsi2"]), "vs_refined": errors(r, ref["fsi2-refined"])})
     labels = [q[2] for q in QUANTITIES]
     print("FSI2 error (%) against CPU seconds, 2006 table [refined values]")
     print("| level | cells | bar cells | s | t_end | wall s | CPU s | CPU s to t = 12 | " + " | ".join(labels) + " |")
     print("|" + "---|" * (8 + len(labels)))
+    def cell(a, b):
+        return "-" if a is None else f"{a:+.1f} [{b:+.1f}]"
+
+    def mean_of(values):
+        values = [v for v in values if v is not None]
+        return sum(values) / len(values) if values else None
+
     for t in table:
-        cols = [f"{t['vs_2006'][k]:+.1f} [{t['vs_refined'][k]:+.1f}]" for k in labels]
+        cols = [cell(t["vs_2006"][k], t["vs_refined"][k]) for k in labels]
         print(f"| {t['level']} | {t['cells']} | {t['bar_cells']} | {t['shift']:g} | {t['t_end']:g} | "
               f"{t['wall_s']:.0f} | {t['cpu_s']:.0f} | {t['cpu_s_to_12']:.0f} | " + " | ".join(cols) + " |")
     means = []
@@ -108,9 +122,9 @@ def main():
         mean = {"level": level, "alignments": [t["shift"] for t in ts], "bar_cells": LEVELS[level][1],
                 "cpu_s_to_12_mean": sum(t["cpu_s_to_12"] for t in ts) / len(ts)}
         for ref_name in ("vs_2006", "vs_refined"):
-            mean[ref_name] = {k: sum(t[ref_name][k] for t in ts) / len(ts) for k in labels}
+            mean[ref_name] = {k: mean_of(t[ref_name][k] for t in ts) for k in labels}
         means.append(mean)
-        cols = [f"{mean['vs_2006'][k]:+.1f} [{mean['vs_refined'][k]:+.1f}]" for k in labels]
+        cols = [cell(mean["vs_2006"][k], mean["vs_refined"][k]) for k in labels]
         print(f"| {level} mean over s = {', '.join(f'{s:g}' for s in mean['alignments'])} | | "
               f"{LEVELS[level][1]} | | | | | {mean['cpu_s_to_12_mean']:.0f} | " + " | ".join(cols) + " |")
     json.dump({"runs": table, "level_means": means}, open(os.path.join(a.out, "cost.json"), "w"), indent=1)
@@ -125,10 +139,11 @@ def main():
     markers = dict(zip(labels, "osD^v"))
     for ax, ref_name, title in zip(axes, ("vs_2006", "vs_refined"), ("2006 table", "refined FEATFLOW values")):
         for k in labels:
-            pts = [(t["cpu_s_to_12"], abs(t[ref_name][k])) for t in table]
+            pts = [(t["cpu_s_to_12"], abs(t[ref_name][k])) for t in table if t[ref_name][k] is not None]
+            mpts = [(m["cpu_s_to_12_mean"], abs(m[ref_name][k])) for m in means if m[ref_name][k] is not None]
             line = ax.loglog([p[0] for p in pts], [p[1] for p in pts], markers[k], alpha=0.35, ms=4)[0]
-            ax.loglog([m["cpu_s_to_12_mean"] for m in means], [abs(m[ref_name][k]) for m in means],
-                      "-" + markers[k], color=line.get_color(), label=f"{k} (line: mean over the alignments run)")
+            ax.loglog([p[0] for p in mpts], [p[1] for p in mpts], "-" + markers[k], color=line.get_color(),
+                      label=f"{k} (line: mean over the alignments run)")
         ax.axhline(3, color="k", ls=":", lw=0.8)  # the 3 % target
         ax.set_xlabel("CPU seconds of the job to t = 12 (both cores)")
         ax.set_title(f"FSI2 against the {title}", fontsize=9)

@@ -74,7 +74,6 @@ import numpy as np  # noqa: E402
 from metrics import at_most, finish, holds, reported  # noqa: E402
 
 
-
 def clearance(text):
     """A clearance h/D, for `type=`: the channel is D + h wide, so h > -1. (A negative h > -1
     makes the folds overlap at t = 0, which the solid refuses naming them and the depth.)"""
@@ -82,6 +81,8 @@ def clearance(text):
         h = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"a number, got '{text}'")
+    if not np.isfinite(h):
+        raise argparse.ArgumentTypeError(f"the clearance h/D must be a finite number, got '{text}'")
     if not h > -1:
         raise argparse.ArgumentTypeError(
             f"the clearance h/D = {text} makes the channel 1 + h = {1 + h:g} D wide, nothing left "
@@ -370,18 +371,23 @@ SETTLE = 1.0
 SUSTAINED, MOVES = 0.5, 1e-6
 # The paper's findings on "about a tenth": a ratio of the impulses within a factor 2 of 0.1.
 TENTH = (0.05, 0.2)
-# A closure of the glottis: the folds touch each other, which alone presses a fold towards its
-# wall (the lower fold's contact force's y component below -CLOSED, or the upper fold's above
-# CLOSED; a wall plane pushes its fold away from the wall, and self-contact sums to zero over
-# a fold; either fold's sum may be cancelled by its plane at a time, hence both). Active
-# contact slots count self-contact and the planes too. CLOSED is in the scene's units
-# (rho_f u_m^2 D), a thousandth of the fluid's force on a fold; episodes less than CLOSURE_GAP
-# apart are one.
+# A closure of the glottis: the folds touch each other: the upper fold's contact force on the
+# lower one (contact_bodies) has a y component below -CLOSED. Runs written before that column
+# read each fold's whole contact force, which only the other fold presses towards its wall (a
+# wall plane pushes its fold away from the wall, self-contact sums to zero over a fold; either
+# fold's sum may be cancelled by its plane at a time, hence both: the lower fold's below
+# -CLOSED or the upper fold's above CLOSED). Active contact slots count self-contact and the
+# planes too. CLOSED is in the scene's units (rho_f u_m^2 D), a thousandth of the fluid's force
+# on a fold; episodes less than CLOSURE_GAP apart are one.
 CLOSED, CLOSURE_GAP = 1e-3, 0.05
 
 
 def folds_touch(hist):
-    """Per row of solid_history.csv: whether the folds press on each other (CLOSED)."""
+    """Per row of solid_history.csv: whether the folds press on each other (CLOSED): from the
+    upper fold's contact force on the lower one where the run wrote it (contact_bodies), else
+    from each fold's whole contact force (below)."""
+    if "lower.contact_bodies_fy" in hist:
+        return hist["lower.contact_bodies_fy"] < -CLOSED
     return (hist["lower.contact_fy"] < -CLOSED) | (hist["upper.contact_fy"] > CLOSED)
 
 
@@ -686,7 +692,8 @@ def sweep_plots(rows, modes_f, x_ref, shapes):
         pr = r.get("data", {}).get("probes")
         if pr is not None:
             a.plot(pr["time"], pr["B_lower.uy"], color=colours[j], lw=0.5)
-            a.axvspan(SETTLE, pr["time"][-1], color="0.92", lw=0)
+            if pr["time"][-1] > SETTLE:
+                a.axvspan(SETTLE, pr["time"][-1], color="0.92", lw=0)
         else:
             a.text(0.5, 0.5, "no data", ha="center", transform=a.transAxes, fontsize=7)
         a.set_ylabel("u_y(B)", fontsize=7)

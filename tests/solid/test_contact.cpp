@@ -267,6 +267,37 @@ TEST_CASE("a step that fails whole is taken as two half steps, with their mean c
   CHECK(cut.min_contact_gap() >= -1e-8 * 0.4);
 }
 
+// The same drop onto a fixed rigid block instead of the plane: the contact force of the other
+// body is then the whole contact force, in steps cut in two (their mean) as in whole ones.
+TEST_CASE("a cut step's contact force from the other body is the halves' mean too",
+          "[contact][dynamic]") {
+  Model model = dropped_block(4, 3);
+  model.planes.clear();
+  BodySpec ground;
+  ground.name = "ground";
+  ground.kind = BodyKind::rigid;
+  ground.mesh = rectangle_mesh(-0.2, -0.1, 0.8, 0.1, 4, 1, Diagonals::right);
+  model.bodies.push_back(ground);
+  ContactPair on_ground;
+  on_ground.slave = 0;
+  on_ground.master = 1;
+  on_ground.two_way = false;
+  model.contacts = {on_ground};
+  Solver s(model);
+  int cut_in_contact = 0, in_contact = 0;
+  for (int k = 0; k < 300; ++k) {
+    const StepReport rep = s.advance(4e-3);
+    const Vec2 total = s.total_contact_force(0), bodies = s.contact_force_from_bodies(0);
+    if (total[1] > 0) ++in_contact, cut_in_contact += rep.substeps > 1;
+    INFO("step " << k << ", " << rep.substeps << " substeps: total (" << total[0] << ", "
+                 << total[1] << "), from the ground (" << bodies[0] << ", " << bodies[1] << ")");
+    CHECK(std::abs(bodies[0] - total[0]) <= 1e-12 * (1 + std::abs(total[1])));
+    CHECK(std::abs(bodies[1] - total[1]) <= 1e-12 * (1 + std::abs(total[1])));
+  }
+  INFO(in_contact << " steps in contact, " << cut_in_contact << " of them cut");
+  CHECK(cut_in_contact > 0);
+}
+
 // The predictor is the worse start where a soft block bounces (solid/README.md, "The
 // predictor"): with steps of 2e-3 it takes up to 8 Newton iterations per step here, from x^n at
 // most 5. With Newton allowed 5 and no cutbacks, each predicted step that needs more is taken
