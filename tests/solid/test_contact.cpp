@@ -10,6 +10,15 @@ using namespace solid;
 
 namespace {
 
+// A contact pair: slave body's nodes against master body's surface (and back when two-way).
+ContactPair pair(int slave, int master, bool two_way) {
+  ContactPair p;
+  p.slave = slave;
+  p.master = master;
+  p.two_way = two_way;
+  return p;
+}
+
 Constraint fixed(const std::string& b, bool x = true, bool y = true) {
   Constraint c;
   c.boundary = b;
@@ -39,11 +48,7 @@ Model two_blocks(double press, int slave, bool two_way, MaterialModel mm) {
   top.displacement = {0, -press};
   b.constraints = {top};
   model.bodies = {a, b};
-  ContactPair p;
-  p.slave = slave;
-  p.master = 1 - slave;
-  p.two_way = two_way;
-  model.contacts = {p};
+  model.contacts = {pair(slave, 1 - slave, two_way)};
   return model;
 }
 
@@ -278,11 +283,7 @@ TEST_CASE("a cut step's contact force from the other body is the halves' mean to
   ground.kind = BodyKind::rigid;
   ground.mesh = rectangle_mesh(-0.2, -0.1, 0.8, 0.1, 4, 1, Diagonals::right);
   model.bodies.push_back(ground);
-  ContactPair on_ground;
-  on_ground.slave = 0;
-  on_ground.master = 1;
-  on_ground.two_way = false;
-  model.contacts = {on_ground};
+  model.contacts = {pair(0, 1, false)};
   Solver s(model);
   int cut_in_contact = 0, in_contact = 0;
   for (int k = 0; k < 300; ++k) {
@@ -388,11 +389,7 @@ TEST_CASE("mirrored blocks touching at t = 0: Newton converges through impact an
       b.constraints = {fixed("top")};
       b.initial_velocity = {0, v};
       model.bodies = {a, b};
-      ContactPair p;
-      p.slave = 0;
-      p.master = 1;
-      p.two_way = two_way;
-      model.contacts = {p};
+      model.contacts = {pair(0, 1, two_way)};
       Solver s(model);
       int contact_steps = 0, worst_iterations = 0;
       double worst_gap = 0;
@@ -509,10 +506,7 @@ TEST_CASE("self-contact: a U's arm pushed onto its other arm stops there", "[con
       b.constraints = {fixed("bottom")};
       model.bodies = {b};
       if (self) {
-        ContactPair p;
-        p.slave = p.master = 0;
-        p.two_way = false;
-        model.contacts = {p};
+        model.contacts = {pair(0, 0, false)};
       }
       Solver s(model);
       const auto reps = s.solve_static();
@@ -567,10 +561,7 @@ int u_node(const Mesh& mesh, double px, double py) {
 
 // A contact set with the mesh's self-contact only.
 void setup_self_contact(ContactSet& set, const Mesh& mesh) {
-  ContactPair self;
-  self.slave = self.master = 0;
-  self.two_way = false;
-  set.setup({&mesh}, {BodyKind::elastic}, {self}, {});
+  set.setup({&mesh}, {BodyKind::elastic}, {pair(0, 0, false)}, {});
 }
 
 // The slot of node n.
@@ -694,11 +685,7 @@ TEST_CASE("two bodies: corner nodes at each other's vertex are one contact", "[c
   for (bool two_way : {true, false}) {
     INFO("two-way " << two_way);
     ContactSet set;
-    ContactPair p;
-    p.slave = 0;
-    p.master = 1;
-    p.two_way = two_way;
-    set.setup({&lower, &upper}, {BodyKind::elastic, BodyKind::elastic}, {p}, {});
+    set.setup({&lower, &upper}, {BodyKind::elastic, BodyKind::elastic}, {pair(0, 1, two_way)}, {});
     auto slot = [&](int body, int n) -> const ContactSlot& {
       for (const auto& s : set.slots())
         if (s.slave_body == body && s.slave_node == n) return s;
@@ -1123,11 +1110,7 @@ TEST_CASE("a lever takes a node the free step left open through: the working set
   block.kind = BodyKind::rigid;
   block.mesh = rectangle_mesh(-0.1, -g_block - 0.1, 0.13, 0.1, 1, 1, Diagonals::right);
   model.bodies = {b, block};
-  ContactPair on_block;
-  on_block.slave = 0;
-  on_block.master = 1;
-  on_block.two_way = false;
-  model.contacts = {on_block};
+  model.contacts = {pair(0, 1, false)};
   ContactPlane plane;
   plane.point = {0, -g_plane};
   plane.normal = {0, 1};
