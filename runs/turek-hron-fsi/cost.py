@@ -9,8 +9,9 @@ seconds of the whole job). For each level and alignment s it takes the row of th
 (a window that settled: README, "FSI2 against the cells' alignment"), and computes the errors
 of u_y(A)'s amplitude and of the drag and lift amplitudes (raw and after the 10 ms average)
 against the 2006 table and the refined FEATFLOW values (reference.csv). The cost axis is the
-CPU seconds to the case's t = 12: of the run to t = 12 where there is one, else of the longer
-run (taken further to let its window settle) scaled by 12 / t_end. Prints one row per run and the mean over the alignments of each level; writes
+CPU seconds to the case's t = 12 of the same run, scaled by 12 / t_end for a run taken further
+to let its window settle (a t = 12 run of the same alignment may not have reached the
+flapping's amplitude). Prints one row per run and the mean over the alignments of each level; writes
 cost.json and cost.png (error against CPU seconds, both references) into DIR.
 """
 import argparse
@@ -43,9 +44,9 @@ def reference():
 
 def study_rows(out):
     """{(level, shift): row} with the longest run of each, the row's file and job times added;
-    its cost_cpu is the CPU time of the run to the case's t = 12 where there is one (a longer
-    run may have gone beside other work), else its own scaled by 12 / t_end."""
-    best, cpu_to_12 = {}, {}
+    its cost_cpu is that run's CPU time scaled by 12 / t_end: the cost and the errors of one run
+    (a shorter run of the same alignment may not have reached the flapping's amplitude)."""
+    best = {}
     for path in sorted(glob.glob(os.path.join(out, "fsi2_shift*.json"))):
         m = re.fullmatch(r"fsi2_shift(?:-(XY\d+))?(?:-t([\d.]+))?\.json", os.path.basename(path))
         if not m:
@@ -63,13 +64,11 @@ def study_rows(out):
                 continue
             jt = json.load(open(times))
             key = (level, row["shift"])
-            if t_end == CASE_T_END:
-                cpu_to_12[key] = jt["cpu_s"]
             if key not in best or t_end > best[key]["t_end"]:
                 best[key] = dict(row, t_end=t_end, level=level, folder=folder,
                                  wall=jt["wall_s"], cpu=jt["cpu_s"])
-    for key, r in best.items():
-        r["cost_cpu"] = cpu_to_12.get(key, r["cpu"] * CASE_T_END / r["t_end"])
+    for r in best.values():
+        r["cost_cpu"] = r["cpu"] * CASE_T_END / r["t_end"]
     return best
 
 
