@@ -15,31 +15,21 @@ flapping's amplitude). Prints one row per run and the mean over the alignments o
 cost.json and cost.png (error against CPU seconds, both references) into DIR.
 """
 import argparse
-import csv
 import glob
 import json
 import os
 import re
 import sys
 
+from case import XY_LEVELS, read_reference  # this folder's
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-# The levels' cells and the bar's thickness in cells (validate.py's LEVELS).
-LEVELS = {"XY82": ("255x70", 4), "XY123": ("353x99", 6), "XY164": ("446x128", 8),
-          "XY246": ("627x182", 12)}
+# Each banded level's cells and the bar's thickness in cells (its elements are half a cell).
+LEVELS = {f"XY{n}": (f"{nx}x{ny}", bar[1] // 2) for n, nx, ny, _, bar in XY_LEVELS}
 CASE_T_END = 12.0  # the case's end time (validate.py), the cost axis's
 QUANTITIES = (("uy", "amplitude", "u_y(A) amp"), ("drag", "amplitude", "drag amp"),
               ("drag_smoothed", "amplitude", "drag amp avg"), ("lift", "amplitude", "lift amp"),
               ("lift_smoothed", "amplitude", "lift amp avg"))
-
-
-def reference():
-    """{case: {quantity: {mean, amplitude, frequency}}} from reference.csv."""
-    ref = {}
-    with open(os.path.join(HERE, "reference.csv")) as f:
-        for row in csv.DictReader(line for line in f if not line.startswith("#")):
-            ref.setdefault(row["case"], {})[row["quantity"]] = {
-                k: float(row[k]) for k in ("mean", "amplitude", "frequency")}
-    return ref
 
 
 def study_rows(out):
@@ -72,12 +62,12 @@ def study_rows(out):
     return best
 
 
-def errors(row, ref):
+def errors(row, ref, case):
     """Signed relative errors in % of the QUANTITIES against one reference case."""
     e = {}
     for q, part, label in QUANTITIES:
         value = row["results"].get(q, {}).get(part)
-        r = ref[q.replace("_smoothed", "")][part]
+        r = ref[(case, q.replace("_smoothed", ""))][part]
         e[label] = None if value is None else 100 * (value - r) / r
     return e
 
@@ -88,7 +78,7 @@ def main():
                                                                            "turek-hron-fsi")))
     a = ap.parse_args()
     a.out = os.path.abspath(a.out)
-    ref = reference()
+    ref = read_reference()
     rows = study_rows(a.out)
     if not rows:
         sys.exit(f"cost.py: no FSI2 shift study with job times in {a.out} (validate.py --xy-shift ...)")
@@ -97,7 +87,7 @@ def main():
         table.append({"level": level, "cells": LEVELS[level][0], "bar_cells": LEVELS[level][1],
                       "shift": s, "t_end": r["t_end"], "wall_s": r["wall"], "cpu_s": r["cpu"],
                       "cpu_s_to_12": r["cost_cpu"],
-                      "vs_2006": errors(r, ref["fsi2"]), "vs_refined": errors(r, ref["fsi2-refined"])})
+                      "vs_2006": errors(r, ref, "fsi2"), "vs_refined": errors(r, ref, "fsi2-refined")})
     labels = [q[2] for q in QUANTITIES]
     print("FSI2 error (%) against CPU seconds, 2006 table [refined values]")
     print("| level | cells | bar cells | s | t_end | wall s | CPU s | CPU s to t = 12 | " + " | ".join(labels) + " |")

@@ -60,6 +60,7 @@ import numpy as np  # noqa: E402
 import outputs  # noqa: E402
 import scenes  # noqa: E402
 import solidout  # noqa: E402
+from case import XY_LEVELS, read_reference  # noqa: E402  (this folder's)
 from metrics import finish, metric, reported  # noqa: E402
 
 _p = cli.parser(__doc__)
@@ -110,16 +111,6 @@ OUT = job.nest(ARGS.body_viscosity and f"body-viscosity-{ARGS.body_viscosity}")
 H, L = 0.41, 2.5
 
 # Turek & Hron (2006), Table "FSI2" and "FSI1" (reference.csv, with the source).
-def read_reference():
-    rows = [ln for ln in open(os.path.join(HERE, "reference.csv")) if not ln.startswith("#")]
-    head = rows[0].strip().split(",")
-    ref = {}
-    for ln in rows[1:]:
-        r = dict(zip(head, ln.strip().split(",")))
-        ref[(r["case"], r["quantity"])] = {k: float(r[k]) for k in ("mean", "amplitude", "frequency")}
-    return ref
-
-
 REF = read_reference()
 QUANTITIES = [("A.ux", "ux", 1.0), ("A.uy", "uy", 1.0), ("total.fx", "drag", 1.0),
               ("total.fy", "lift", 1.0)]
@@ -141,9 +132,7 @@ LEVELS = {
 # bar 8 and 12 cells thick; --shift-level) continue the refinement with the same growth ratios,
 # bar elements half a cell and dt / h as on XY82 and XY123 respectively (0.1, 0.075). These FSI2
 # levels are named by h = 0.41/n; fsi1_bands_xy() names its grids by their rows.
-for _n, _nx, _ny, _dt, _bar in ((82, 255, 70, 5e-4, [140, 8]), (123, 353, 99, 2.5e-4, [210, 12]),
-                                (164, 446, 128, 2.5e-4, [280, 16]),
-                                (246, 627, 182, 1.25e-4, [420, 24])):
+for _n, _nx, _ny, _dt, _bar in XY_LEVELS:
     _h = H / _n
     LEVELS[f"XY{_n}"] = {"n": _ny, "nx": _nx, "lc": _h, "dt": _dt, "bar": _bar,
                          "x_band": (0.1, 0.9, int(round(0.8 / _h))),

@@ -779,14 +779,11 @@ def sweep_plots(rows, modes_f, x_ref, shapes):
         for i, c in enumerate(("x", "y")):
             a = ax[i, j]
             a.plot(fo["time"], fo[f"lower.f{c}"], lw=0.6, label=f"fluid, impulse {r['impulse_fluid'][i]:.4g}")
+            a.plot(hs["time"], hs[f"lower.contact_f{c}"], lw=0.4, color="0.6",
+                   label=f"all contact (with the wall plane), impulse {r['impulse_contact_all'][i]:.4g}")
             if f"lower.contact_bodies_f{c}" in hs:
-                a.plot(hs["time"], hs[f"lower.contact_f{c}"], lw=0.4, color="0.6",
-                       label=f"all contact (with the wall plane), impulse {r['impulse_contact_all'][i]:.4g}")
                 a.plot(hs["time"], hs[f"lower.contact_bodies_f{c}"], lw=0.6,
                        label=f"contact of the upper fold, impulse {r['impulse_contact'][i]:.4g}")
-            else:
-                a.plot(hs["time"], hs[f"lower.contact_f{c}"], lw=0.6,
-                       label=f"all contact (with the wall plane), impulse {r['impulse_contact'][i]:.4g}")
             a.set_xlabel("t")
             a.set_ylabel(f"force on the lower fold, {c}")
             a.set_title(f"{label[id(r)]}: to t = {r['end']:.3f}" + ("" if r["reached"] else f" ({r['state']})"),
