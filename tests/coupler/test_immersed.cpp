@@ -123,8 +123,29 @@ std::vector<Vec2> clip_convex(std::vector<Vec2> poly, double x0, double x1, doub
 }
 
 
+// The control volume |CV| of face idx of family comp (0: u, 1: v) from the grid's faces alone,
+// independently of FaceBoxes: a u-face's spans x between the centres of its two cells (across a
+// periodic side, the last cell's and the first's) and y over its row; a v-face's the other way
+// round. Interior and periodic faces only (a boundary face fails the REQUIRE).
+double face_volume(const proto::GridInfo& g, int comp, std::int32_t idx) {
+  auto width = [](const std::vector<double>& f, int k, bool periodic) {
+    const int n = static_cast<int>(f.size()) - 1;
+    if (periodic) k = (k + n) % n;
+    REQUIRE(k >= 0);
+    REQUIRE(k < n);
+    return f[k + 1] - f[k];
+  };
+  const bool px = g.periodic_x != 0, py = g.periodic_y != 0;
+  const int ni = comp == 0 && !px ? g.nx + 1 : g.nx;
+  const int i = idx % ni, j = idx / ni;
+  if (comp == 0)
+    return 0.5 * (width(g.x_face, i - 1, px) + width(g.x_face, i, px)) * width(g.y_face, j, false);
+  return width(g.x_face, i, false) * 0.5 * (width(g.y_face, j - 1, py) + width(g.y_face, j, py));
+}
+
 // The fluid's forcing f_s (random values on the faces the body touches) and its nodal reaction:
-// Σ_CV f_s |CV| + Σ_a F_a per component, which must vanish, and Σ |f_s| |CV| for its scale.
+// Σ_CV f_s |CV| + Σ_a F_a per component, which must vanish, and Σ |f_s| |CV| for its scale
+// (|CV| from face_volume, not from the FaceBoxes the reaction uses).
 struct Balance {
   double fx = 0, fy = 0, scale = 0;
 };
@@ -137,13 +158,12 @@ Balance action_plus_reaction(const proto::GridInfo& g, const ImmersedSolid& is,
   std::vector<std::vector<double>> F;
   is.reaction(fs_u, fs_v, F);
   Balance b;
-  const auto ub = FaceBoxes::u_faces(g), vb = FaceBoxes::v_faces(g);
   for (std::size_t k = 0; k < u.index.size(); ++k) {
-    const double f = fs_u[k] * ub.volume(u.index[k] % ub.ni, u.index[k] / ub.ni);
+    const double f = fs_u[k] * face_volume(g, 0, u.index[k]);
     b.fx += f, b.scale += std::abs(f);
   }
   for (std::size_t k = 0; k < v.index.size(); ++k) {
-    const double f = fs_v[k] * vb.volume(v.index[k] % vb.ni, v.index[k] / vb.ni);
+    const double f = fs_v[k] * face_volume(g, 1, v.index[k]);
     b.fy += f, b.scale += std::abs(f);
   }
   for (const auto& fb : F)
