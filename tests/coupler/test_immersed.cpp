@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include "clip.hpp"
@@ -126,17 +127,19 @@ std::vector<Vec2> clip_convex(std::vector<Vec2> poly, double x0, double x1, doub
 // The control volume |CV| of face idx of family comp (0: u, 1: v) from the grid's faces alone,
 // independently of FaceBoxes: a u-face's spans x between the centres of its two cells (across a
 // periodic side, the last cell's and the first's) and y over its row; a v-face's the other way
-// round. Interior and periodic faces only (a boundary face fails the REQUIRE).
+// round. Interior faces and those of a periodic side only: a boundary face of another side, or
+// an index outside the grid, throws.
 double face_volume(const proto::GridInfo& g, int comp, std::int32_t idx) {
   auto width = [](const std::vector<double>& f, int k, bool periodic) {
     const int n = static_cast<int>(f.size()) - 1;
-    if (periodic) k = (k + n) % n;
-    REQUIRE(k >= 0);
-    REQUIRE(k < n);
+    if (periodic && k == -1) k = n - 1;  // the cell before the first, across the period
+    if (k < 0 || k >= n) throw std::out_of_range("face_volume: a boundary face");
     return f[k + 1] - f[k];
   };
   const bool px = g.periodic_x != 0, py = g.periodic_y != 0;
   const int ni = comp == 0 && !px ? g.nx + 1 : g.nx;
+  const int nj = comp == 1 && !py ? g.ny + 1 : g.ny;
+  if (idx < 0 || idx >= ni * nj) throw std::out_of_range("face_volume: no such face");
   const int i = idx % ni, j = idx / ni;
   if (comp == 0)
     return 0.5 * (width(g.x_face, i - 1, px) + width(g.x_face, i, px)) * width(g.y_face, j, false);
@@ -222,20 +225,22 @@ std::vector<AreaCase> area_cases() {
   return cases;
 }
 
-// The grid g with both directions stretched, as bands give (finer in the middle, coarser towards
-// the ends): each face moved by s -> s + a sin(2 pi s) / (2 pi) of its direction's span, whose
-// spacing goes as 1 + a cos(2 pi s) (monotone for a < 1; the ends stay, so a periodic direction
-// keeps its period).
+// The grid g with both directions stretched (the ends stay, so a periodic direction keeps its
+// period). x: each face moved by s -> s + a s (s - 1) of the span, the spacing 1 + a (2s - 1)
+// growing from one end to the other, so that across a periodic side the last cell is
+// (1 + a)/(1 - a) times as wide as the first. y: s -> s + a sin(2 pi s) / (2 pi), the spacing
+// 1 + a cos(2 pi s), finer in the middle and coarser towards the ends, as bands give. Both
+// monotone for a < 1.
 proto::GridInfo stretched_both(proto::GridInfo g) {
-  auto warp = [](std::vector<double>& f, double a) {
+  auto warp = [](std::vector<double>& f, auto shift) {
     const double lo = f.front(), len = f.back() - f.front(), n = double(f.size() - 1);
     for (std::size_t k = 1; k + 1 < f.size(); ++k) {
       const double s = k / n;
-      f[k] = lo + len * (s + a * std::sin(2 * M_PI * s) / (2 * M_PI));
+      f[k] = lo + len * (s + shift(s));
     }
   };
-  warp(g.x_face, 0.45);
-  warp(g.y_face, 0.6);
+  warp(g.x_face, [](double s) { return 0.45 * s * (s - 1); });
+  warp(g.y_face, [](double s) { return 0.6 * std::sin(2 * M_PI * s) / (2 * M_PI); });
   return g;
 }
 
