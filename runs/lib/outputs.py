@@ -14,6 +14,15 @@ def table(path, in_progress=False):
                                        invalid_raise=not in_progress))
 
 
+def commented_rows(path):
+    """The rows of a small CSV file with a header row, whose blank lines and lines starting with
+    `#` (sources, notes) are skipped, as dicts of strings by column name; the last column keeps
+    any commas of its own (a source's text)."""
+    lines = [ln.strip() for ln in open(path) if ln.strip() and not ln.startswith("#")]
+    head = lines[0].split(",")
+    return [dict(zip(head, ln.split(",", len(head) - 1))) for ln in lines[1:]]
+
+
 def summary(folder):
     """A run's summary.json (settings, steps, wall time per program, the program's results)."""
     with open(os.path.join(folder, "summary.json")) as f:

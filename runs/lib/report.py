@@ -14,6 +14,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+import outputs  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 BENCHES = ["fluid", "solid", "fiber", "coupler", "coupled", "protocol"]
@@ -21,15 +22,10 @@ BENCHES = ["fluid", "solid", "fiber", "coupler", "coupled", "protocol"]
 
 def peers(path=os.path.join(HERE, "peers.csv")):
     """Rows of peers.csv as dicts (numbers as float, empty as None)."""
-    lines = [ln.rstrip("\n") for ln in open(path) if ln.strip() and not ln.startswith("#")]
-    head = lines[0].split(",")
-    rows = []
-    for ln in lines[1:]:
-        cells = ln.split(",", len(head) - 1)
-        r = dict(zip(head, cells))
+    rows = outputs.commented_rows(path)
+    for r in rows:
         for k in ("value", "error", "cpu_s"):
             r[k] = float(r[k]) if r.get(k) else None
-        rows.append(r)
     return rows
 
 

@@ -89,14 +89,9 @@ TAU_TAG = "" if ARGS.forcing_time is None else f"-tau{ARGS.forcing_time:g}"
 # Reference values: Turek & Hron (2006), CFD1 and CFD2, in reference.csv with their source; both
 # cases are steady in the benchmark.
 def read_reference():
-    lines = [ln for ln in open(os.path.join(HERE, "reference.csv")) if not ln.startswith("#")]
-    head = lines[0].strip().split(",")
-    cases = {}
-    for ln in lines[1:]:
-        row = dict(zip(head, ln.strip().split(",")))
-        cases[row["case"]] = {"U": float(row["mean_inflow"]), "drag": float(row["drag"]),
-                              "lift": float(row["lift"])}
-    return cases
+    return {r["case"]: {"U": float(r["mean_inflow"]), "drag": float(r["drag"]),
+                        "lift": float(r["lift"])}
+            for r in outputs.commented_rows(os.path.join(HERE, "reference.csv"))}
 
 
 CASES = read_reference()
