@@ -316,6 +316,16 @@ Config read_config(const fsi::SceneTable& f, double dt) {
   }
   if (f.has("forcing_time")) c.forcing_time = f.non_negative("forcing_time");
   // Only when given: a scene without it keeps its effective scene as it was.
+  if (f.has("interface")) {
+    c.sharp_interface = f.choice("interface", {"volume", "sharp"}, "volume") == "sharp";
+    if (c.sharp_interface && c.implicit)
+      f.fail("interface", "= \"sharp\" applies to explicit diffusion only: set diffusion = "
+                          "\"explicit\" or interface = \"volume\"");
+    if (c.sharp_interface && f.has("forcing_time"))
+      f.fail("interface", "= \"sharp\" places the wall itself and takes no forcing_time: remove "
+                          "fluid.forcing_time or set interface = \"volume\"");
+  }
+  // Only when given: a scene without it keeps its effective scene as it was.
   if (f.has("upwind_blend")) c.upwind_blend = f.in_range("upwind_blend", 0.0, 1.0, false, 0.0);
   if (f.has("convection"))
     c.upwind3 = f.choice("convection", {"central", "upwind3"}, "central") == "upwind3";

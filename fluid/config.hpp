@@ -102,6 +102,12 @@ struct Config {
   // steady flow's slip in a cut face is (1 - alpha)/alpha tau R whatever dt; < 0 (not given):
   // tau = dt, beta = alpha (paper Eq. 21 as written).
   double forcing_time = -1;
+  // fluid.interface = "volume" (the default, paper Eq. 21): a cut face blended by its volume
+  // fraction; "sharp": a cut face whose centre lies outside the body takes the value on the line
+  // from the wall (placed from the face's volume fraction) to the next face out, one whose centre
+  // lies inside the body is held at u_s (forcing.cpp, sharp_targets). Explicit diffusion, one
+  // fluid rank, without forcing_time.
+  bool sharp_interface = false;
   // Weight of first-order upwind in the convective fluxes outside the sponge (0: central).
   double upwind_blend = 0;
   // fluid.convection = "upwind3": third-order upwind-biased carried values outside the sponge

@@ -6,6 +6,9 @@ namespace fluid {
 namespace {
 // A face the body covers (alpha = 1 up to the footprint's round-off).
 constexpr double kCovered = 1 - 1e-9;
+// A face the body only touches (alpha = 0 up to the footprint's round-off: a body's edge on the
+// box's edge).
+constexpr double kTouched = 1e-9;
 }  // namespace
 
 // The relaxation time tau (fluid.forcing_time). The predictor carries the pressure gradient of
@@ -56,10 +59,20 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
     fsi::fail("protocol error: the step's solid faces changed between its solve and its forcing "
               "({} and {} u, v faces against {} and {})", m_pull[0].size(), m_pull[1].size(),
               in.solid_u_index.size(), in.solid_v_index.size());
+  const bool sharp = m_cfg.sharp_interface;
+  if (sharp) {
+    sharp_targets(0, in, m_sharp_target[0]);
+    sharp_targets(1, in, m_sharp_target[1]);
+  }
   // The force on one face, whose velocity is w (alpha a, body velocity ws, pull of the
-  // increment's forcing).
+  // increment's forcing; sharp: ws is the face's target, reached whole).
   auto force = [&](double& w, double a, double ws, double pull) {
     if (cn) return rho * pull / dt;
+    if (sharp) {
+      const double f = rho * (ws - w) / dt;
+      w = ws;
+      return f;
+    }
     const double f = rho * forcing_fraction(a, dt) * (ws - w) / dt;
     w += dt * f / rho;
     return f;
@@ -68,18 +81,142 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
     const auto [i, j] = face_of(0, in.solid_u_index[q]);
     out.solid_u_force[q] =
         i >= m_iu0 && i < m_iu1
-            ? force(m_u(i, owned(j, 0)), in.solid_u_alpha[q], in.solid_u_velocity[q],
-                    cn ? m_pull[0][q] : 0.0)
+            ? force(m_u(i, owned(j, 0)), in.solid_u_alpha[q],
+                    sharp ? m_sharp_target[0][q] : in.solid_u_velocity[q], cn ? m_pull[0][q] : 0.0)
             : 0.0;
   }
   for (std::size_t q = 0; q < in.solid_v_index.size(); ++q) {
     const auto [i, j] = face_of(1, in.solid_v_index[q]);
     out.solid_v_force[q] =
         j >= m_j0 && owned(j, 1) < ny
-            ? force(m_v(i, j), in.solid_v_alpha[q], in.solid_v_velocity[q],
-                    cn ? m_pull[1][q] : 0.0)
+            ? force(m_v(i, j), in.solid_v_alpha[q],
+                    sharp ? m_sharp_target[1][q] : in.solid_v_velocity[q], cn ? m_pull[1][q] : 0.0)
             : 0.0;
   }
+}
+
+// interface = "sharp": a face's target from the predictor u~ (before any face is forced).
+// The face's control volume V (its box) is cut by the wall; its volume fraction alpha and the
+// volume fractions of its four neighbours of the same family give the wall's normal,
+// n ~ -grad alpha (central differences on the face positions). Along the grid direction d where
+// |d alpha/dx_d| is largest, with s = +1 when the fluid lies towards +x_d (alpha falls that way),
+// the wall crosses the face's own grid line at
+//   x_w = lo + alpha (hi - lo)  (s = +1),   x_w = hi - alpha (hi - lo)  (s = -1),
+// [lo, hi] the box along d: exact for a straight wall across the box's middle band (the box's
+// area fraction is then the fraction of its centre line, on whichever side; the box's own
+// centre line along d is the face's, which is where the face's velocity lives). With x_f the
+// face and x_n its neighbour one face further into the fluid, dist = s (x_f - x_w) (in about
+// [-h/2, h/2]: the box meets the wall),
+//   u = u_s + (u~_n - u_s) dist / (s (x_n - x_w)),
+// the line from the wall's velocity at x_w through the fluid's at x_n: an interpolation when the
+// face's centre is in the fluid (Fadlun et al. 2000, J. Comput. Phys. 161, 35, along one grid
+// direction), an extrapolation into the body when it is inside (weight on u~_n down to -1), as a
+// ghost cell. Either way the faces hold a linear profile whatever the wall's place in the cell:
+// the faces a box-based footprint lists are those within half a cell of the wall, so the first
+// fluid face beyond a face whose centre is inside is not listed, and holding that face at u_s
+// would put the wall at its centre. u_s, the body's mean velocity in the box, stands for the
+// wall's.
+// A covered face (alpha = 1) is held at u_s, unless the wall runs along its box's edge: its
+// neighbour along d is not touched (alpha_n = 0, so not listed), and it extrapolates as above with
+// the wall at the edge (dist = -h/2). A face with no usable neighbour (alpha not falling along
+// d, the neighbour a boundary face or no lower alpha) keeps the paper's blend,
+// (1 - alpha) u~ + alpha u_s; so does a face without a gradient (a sliver inside one box).
+void Solver::sharp_targets(int comp, const CouplingIn& in, std::vector<double>& target) {
+  const auto index = comp == 0 ? in.solid_u_index : in.solid_v_index;
+  const auto alpha = comp == 0 ? in.solid_u_alpha : in.solid_v_alpha;
+  const auto us = comp == 0 ? in.solid_u_velocity : in.solid_v_velocity;
+  const Field& w = comp == 0 ? m_u : m_v;
+  const Axis& ax = m_grid.x();
+  const Axis& ay = m_grid.y();
+  // The family's faces: ni x nj, and its unknowns [ilo, ihi) x [jlo, jhi).
+  const int ni = comp == 0 ? m_grid.nu() : m_grid.nx();
+  const int nj = comp == 0 ? m_grid.ny() : m_grid.nv();
+  const int ilo = comp == 0 ? m_iu0 : 0, ihi = comp == 0 ? m_iu1 : m_grid.nx();
+  const int jlo = comp == 0 ? 0 : m_j0, jhi = m_grid.ny();
+  const bool per[2] = {ax.periodic(), ay.periodic()};
+  // Position of face i along x (or j along y) for this family, and its box [lo, hi]: a u-face
+  // sits on x faces, its box between the cell centres; along y on centres, its box between the
+  // faces (v the other way round). Indices may run one past either end (Axis has them).
+  auto pos = [&](int a, int k) {
+    const Axis& g = a == 0 ? ax : ay;
+    return (a == comp) ? g.face(k) : g.centre(k);
+  };
+  auto box = [&](int a, int k) -> std::array<double, 2> {
+    const Axis& g = a == 0 ? ax : ay;
+    if (a == comp) return {g.centre(k - 1), g.centre(k)};
+    return {g.face(k), g.face(k + 1)};
+  };
+  std::vector<double>& amap = m_sharp_alpha[comp];
+  std::vector<std::int32_t>& slot = m_sharp_slot[comp];
+  if (amap.size() != std::size_t(ni) * nj) {
+    amap.assign(std::size_t(ni) * nj, 0.0);
+    slot.assign(std::size_t(ni) * nj, -1);
+  }
+  for (std::size_t q = 0; q < index.size(); ++q)
+    amap[index[q]] = alpha[q], slot[index[q]] = std::int32_t(q);
+  // Index k + step along axis a wrapped when periodic; -1 when it leaves the faces.
+  auto along = [&](int a, int k, int step) {
+    const int n = a == 0 ? ni : nj;
+    k += step;
+    if (per[a]) return (k + n) % n;
+    return k < 0 || k >= n ? -1 : k;
+  };
+  // Each face's line: its neighbour (i, j) and the weight dist / span, or none (i = -1).
+  std::vector<SharpLine>& lines = m_sharp_lines[comp];
+  lines.assign(index.size(), SharpLine{});
+  target.resize(index.size());
+  for (std::size_t q = 0; q < index.size(); ++q) {
+    const auto [i, j] = face_of(comp, index[q]);
+    const double a = alpha[q];
+    const bool covered = a >= kCovered;
+    target[q] = covered ? us[q] : (1 - a) * w(i, j) + a * us[q];
+    if (a <= kTouched) continue;
+    // d alpha / dx_d by central differences (one-sided where a neighbour leaves the faces).
+    double g[2];
+    for (int d = 0; d < 2; ++d) {
+      const int k = d == 0 ? i : j;
+      const int kp = along(d, k, 1), km = along(d, k, -1);
+      auto at = [&](int kk) {
+        if (kk < 0) return a;
+        return d == 0 ? amap[kk + std::size_t(ni) * j] : amap[i + std::size_t(ni) * kk];
+      };
+      const double xp = kp < 0 ? pos(d, k) : pos(d, k + 1);
+      const double xm = km < 0 ? pos(d, k) : pos(d, k - 1);
+      g[d] = xp > xm ? (at(kp) - at(km)) / (xp - xm) : 0.0;
+    }
+    const int d = std::abs(g[0]) >= std::abs(g[1]) ? 0 : 1;
+    if (g[d] == 0) continue;
+    const int s = g[d] < 0 ? 1 : -1;
+    const int k = d == 0 ? i : j;
+    const auto [lo, hi] = box(d, k);
+    const double xw = s > 0 ? lo + a * (hi - lo) : hi - a * (hi - lo);
+    const double dist = s * (pos(d, k) - xw);
+    const int kn = along(d, k, s);
+    if (kn < 0) continue;
+    const int in_ = d == 0 ? kn : i, jn = d == 0 ? j : kn;
+    if (in_ < ilo || in_ >= ihi || jn < jlo || jn >= jhi) continue;
+    const double an = amap[in_ + std::size_t(ni) * jn];
+    if (an >= a || an > 0.25 || (covered && an > kTouched)) continue;
+    // The neighbour's coordinate unwrapped (one face on from k, across a periodic seam too).
+    const double span = s * (pos(d, k + s) - xw);
+    if (span <= 0) continue;
+    lines[q] = {in_, jn, dist / span};
+    target[q] = us[q] + (w(in_, jn) - us[q]) * lines[q].r;
+  }
+  // A neighbour that is itself forced (a cut face, alpha_n <= 1/4) takes its own target, not
+  // its predictor: in a steady flow the predictor of a forced face differs from its velocity by
+  // dt R, which would otherwise leave a slip of order dt in the faces that read it. The
+  // neighbour's own line reads a face further out, which is free (or forced the same way, read
+  // here at its first value).
+  std::vector<double>& first = m_sharp_first[comp];
+  first.assign(target.begin(), target.end());
+  for (std::size_t q = 0; q < index.size(); ++q) {
+    const SharpLine& l = lines[q];
+    if (l.i < 0) continue;
+    const std::int32_t qn = slot[l.i + std::size_t(ni) * l.j];
+    if (qn >= 0) target[q] = us[q] + (first[qn] - us[q]) * l.r;
+  }
+  for (std::size_t q = 0; q < index.size(); ++q) amap[index[q]] = 0.0, slot[index[q]] = -1;
 }
 
 }  // namespace fluid

@@ -125,6 +125,11 @@ Solver::Solver(const Config& c, double dt, MPI_Comm comm)
       m_bnd(m_grid, c.bc, m_dec),
       m_sponge(sponge_weights(m_grid, c.upwind_blend)) {
   validate(c, dt);
+  if (c.sharp_interface && !m_dec.serial())
+    throw fsi::InputError(fmt::format(
+        "fluid.interface = \"sharp\" runs on one fluid rank, the job gives the fluid {}: set "
+        "fluid.ranks = 1 or interface = \"volume\" (in {})",
+        m_dec.ranks(), c.source));
   m_dilation_share = dilation_share(1);
   m_nu = c.viscosity / c.density;
   const int nx = m_grid.nx(), ny = m_grid.ny();

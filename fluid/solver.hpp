@@ -170,6 +170,9 @@ class Solver {
   // The fraction of the way to u_s a face of volume fraction alpha is forced in a step of dt:
   // alpha (Eq. 21), or beta with forcing_time (forcing.cpp).
   double forcing_fraction(double alpha, double dt) const;
+  // interface = "sharp": the value each solid face of family comp (0 = u, 1 = v) is forced to
+  // from the predictor, in the input's order (forcing.cpp).
+  void sharp_targets(int comp, const CouplingIn& in, std::vector<double>& target);
   void remove_body_viscosity(double dt, const CouplingIn& in);  // body_viscosity.cpp
   // dt, and the time whose boundary pressures p^(n+1) takes (t^n + dt; t^n for project_initial).
   void project(double dt, double t_new);                                    // projection.cpp
@@ -242,6 +245,15 @@ class Solver {
   // coupling input (solve_implicit).
   Field m_un, m_vn;
   std::array<std::vector<double>, 2> m_pull;
+  // interface = "sharp": each family's volume fractions and input slots on the whole grid (0
+  // and -1 between steps), the step's targets, and sharp_targets' scratch.
+  std::array<std::vector<double>, 2> m_sharp_alpha, m_sharp_target, m_sharp_first;
+  std::array<std::vector<std::int32_t>, 2> m_sharp_slot;
+  struct SharpLine {
+    int i = -1, j = -1;  // the neighbour the face's line reads (i = -1: none)
+    double r = 0;        // its weight, dist / span
+  };
+  std::array<std::vector<SharpLine>, 2> m_sharp_lines;
   // body_viscosity = "none": the elastic bodies' volume fraction per u, v face, zero
   // between steps; the step's α, centre fluxes (u, v) and corner fluxes on their boxes
   // (body_viscosity.cpp).

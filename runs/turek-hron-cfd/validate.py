@@ -28,6 +28,9 @@ so both give the same forces here; the README's "none" table was measured before
 (increment, the fluid's default; after_solve: the forcing of the tables measured before it), every
 output under OUT/implicit-forcing-X. `--forcing-time` blends either forcing (the README's
 forcing-time tables before this release took after_solve: `--implicit-forcing after_solve`).
+`--interface volume|sharp`: explicit diffusion with fluid.interface written into the scenes
+(volume: the paper's blend, Eq. 21; sharp: the wall placed inside its cell, fluid/forcing.cpp),
+every output under OUT/interface-X; not given: the committed scenes' Crank-Nicolson.
 Environment (set by `./fsi validate`): FSI_ROOT, FSI_BIN, FSI_OUT; FSI_MPIRUN."""
 import glob
 import json
@@ -70,6 +73,8 @@ _p.add_argument("--helmholtz", choices=["direct", "factored"], default="factored
                 help="fluid.helmholtz of the scenes (Crank-Nicolson's Helmholtz solves)")
 cli.body_viscosity(_p, "the scenes")
 cli.implicit_forcing(_p, "the scenes")
+_p.add_argument("--interface", choices=("volume", "sharp"), default=None,
+                help="explicit diffusion with this fluid.interface (outputs under OUT/interface-X)")
 ARGS = _p.parse_args()
 if ARGS.xy_shift and not ARGS.bands_xy:
     _p.error("--xy-shift goes with --bands-xy")
@@ -79,7 +84,10 @@ SHORT, REUSE = ARGS.short, ARGS.reuse
 HERE = os.path.dirname(os.path.abspath(__file__))
 job.out_dir("turek-hron-cfd")
 OUT = job.nest(ARGS.body_viscosity and f"body-viscosity-{ARGS.body_viscosity}",
-               ARGS.implicit_forcing and f"implicit-forcing-{ARGS.implicit_forcing}")
+               ARGS.implicit_forcing and f"implicit-forcing-{ARGS.implicit_forcing}",
+               ARGS.interface and f"interface-{ARGS.interface}")
+if ARGS.interface and (ARGS.implicit_forcing or ARGS.forcing_time is not None):
+    _p.error("--interface runs explicit diffusion: no --implicit-forcing or --forcing-time")
 # Crank-Nicolson's forcing written into the scenes (None: not written, the fluid's "increment");
 # each choice has its own output folder (OUT), so the --bands-xy JSONs of the two do not mix.
 FORCING = ARGS.implicit_forcing
@@ -146,6 +154,10 @@ def scene_text(case, n, dt=None, band=None, name=None, x_band=None, columns=None
             line = replace.pop(key)
         elif key == "mesh":
             line = f'mesh = "{os.path.join(HERE, "obstacle.geo")}"'
+        elif key == "diffusion" and ARGS.interface:
+            line = f'diffusion = "explicit"\ninterface = "{ARGS.interface}"'
+            if ARGS.body_viscosity is not None:
+                line += f'\nbody_viscosity = "{ARGS.body_viscosity}"'
         elif key == "diffusion":
             line += f'\nhelmholtz = "{ARGS.helmholtz}"'
             if ARGS.forcing_time is not None:

@@ -172,6 +172,22 @@ TEST_CASE("forcing_time: read with every diffusion and forcing, refused negative
             .forcing_time == 0.0);
 }
 
+TEST_CASE("interface: volume by default, sharp with explicit diffusion only", "[fluid][config]") {
+  auto with = [](const std::string& keys) {
+    return replace(kGood, "viscosity = 0.01", "viscosity = 0.01\n" + keys);
+  };
+  CHECK_FALSE(read(kGood).sharp_interface);
+  CHECK_FALSE(read(with("interface = \"volume\"")).sharp_interface);
+  CHECK(read(with("interface = \"sharp\"")).sharp_interface);
+  CHECK_THROWS_WITH(read(with("interface = \"sharp\"\ndiffusion = \"implicit\"")),
+                    Contains("fluid.interface") && Contains("explicit diffusion") &&
+                        Contains("fluid_config_test.toml"));
+  CHECK_THROWS_WITH(read(with("interface = \"sharp\"\nforcing_time = 0.0")),
+                    Contains("fluid.interface") && Contains("forcing_time"));
+  CHECK_THROWS_WITH(read(with("interface = \"smooth\"")),
+                    Contains("interface") && Contains("smooth") && Contains("sharp"));
+}
+
 TEST_CASE("implicit_forcing: read with Crank-Nicolson, refused without it or unknown",
           "[fluid][config][implicit]") {
   const std::string cn = replace(kGood, "viscosity = 0.01", "viscosity = 0.01\ndiffusion = \"implicit\"");
