@@ -101,29 +101,43 @@ void Coupler::check_can_iterate() const {
 // take no load (fixed or prescribed; solid-rigid's free bodies come as elastic ones). Steady
 // FSI1 with forcing_time = 0 gave u_y(A) +52 % against +12 % (runs/turek-hron-fsi): the held
 // cut faces over the bent bar, not the inertia, which a steady state does not see.
-//
-// fluid.interface = "sharp" forces the faces near a wall along a line from the wall through the
-// next fluid face (fluid/forcing.cpp): a face barely touched is forced a third of the way to u_s
-// where Eq. 21 moves it by its alpha, so the fluid held to a body is no longer its own volume.
-// Measured with the explicit step (runs/turek-hron-fsi, README): FSI2 on 270 x 82 cells
-// diverged at t = 1.62 and steady FSI1 (rho_s = 10 rho_f) at t = 4.19, both holding with
-// Eq. 21. So the same rule.
 void Coupler::check_forcing_time() const {
   if (!has(Role::fluid) || !has(Role::solid)) return;
   const auto fluid = m_rt.root().optional_table("fluid");  // (the fluid checked the keys)
   if (!fluid) return;
-  const bool tau = fluid->has("forcing_time");
-  const bool sharp = fluid->has("interface") && fluid->string("interface") == "sharp";
-  if (!tau && !sharp) return;
-  const std::string key = tau ? fmt::format("fluid.forcing_time = {}", fluid->number("forcing_time"))
-                              : std::string("fluid.interface = \"sharp\"");
-  for (const auto& b : m_meshes.bodies)
-    if (b.kind == proto::BodyKind::elastic)
+  if (fluid->has("forcing_time")) {
+    const double tau = fluid->number("forcing_time");
+    for (const auto& b : m_meshes.bodies)
+      if (b.kind == proto::BodyKind::elastic)
+        throw fsi::InputError(fmt::format(
+            "fluid.forcing_time = {} is for bodies that take no load (rigid bodies, fixed or with "
+            "a prescribed motion): body '{}' moves under the fluid's load, and its reaction "
+            "assumes the forcing of Eq. 21; remove fluid.forcing_time (in {})",
+            tau, b.name, m_rt.scene().file().string()));
+  }
+  // fluid.interface = "sharp" places the walls of the bodies that take no load; an elastic
+  // body's faces keep Eq. 21, known to the fluid by FaceSolid::elastic (fluid/forcing.cpp). A
+  // free rigid body takes load but is not elastic there, so it is refused; with no fixed or
+  // prescribed body the key would change nothing.
+  if (fluid->has("interface") && fluid->string("interface") == "sharp") {
+    const std::string file = m_rt.scene().file().string();
+    bool any = false;
+    for (const auto& b : m_meshes.bodies) {
+      if (b.kind == proto::BodyKind::elastic && b.rigid != 0)
+        throw fsi::InputError(fmt::format(
+            "fluid.interface = \"sharp\" places the walls of bodies that take no load (rigid "
+            "bodies, fixed or with a prescribed motion): body '{}' is a free rigid body, which "
+            "moves under the fluid's load; remove fluid.interface (in {})",
+            b.name, file));
+      any |= b.kind != proto::BodyKind::elastic;
+    }
+    if (!any)
       throw fsi::InputError(fmt::format(
-          "{} is for bodies that take no load (rigid bodies, fixed or with a prescribed "
-          "motion): body '{}' moves under the fluid's load, and its reaction assumes the forcing "
-          "of Eq. 21; remove {} (in {})",
-          key, b.name, tau ? "fluid.forcing_time" : "fluid.interface", m_rt.scene().file().string()));
+          "fluid.interface = \"sharp\" places the walls of bodies that take no load (rigid "
+          "bodies, fixed or with a prescribed motion), and every body of this scene moves under "
+          "the fluid's load (their faces keep Eq. 21); remove fluid.interface (in {})",
+          file));
+  }
 }
 
 // Set-up, once: grid from the fluid; meshes and initial state from the solid; layout from the

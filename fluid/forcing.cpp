@@ -116,6 +116,10 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
 // fluid face beyond a face whose centre is inside is not listed, and holding that face at u_s
 // would put the wall at its centre. u_s, the body's mean velocity in the box, stands for the
 // wall's.
+// Only the faces of bodies that take no load (no elastic part in alpha) are placed so: an
+// elastic body's faces keep Eq. 21, whose alpha makes the fluid the body carries its own volume
+// (the coupler's solid equation counts on it; with the line on an elastic bar, FSI2 and FSI1
+// diverged: runs/turek-hron-fsi/README.md).
 // A covered face (alpha = 1) is held at u_s, unless the wall runs along its box's edge: its
 // neighbour along d is not touched (alpha_n = 0, so not listed), and it extrapolates as above with
 // the wall at the edge (dist = -h/2). A face with no usable neighbour (alpha not falling along
@@ -125,6 +129,8 @@ void Solver::sharp_targets(int comp, const CouplingIn& in, std::vector<double>& 
   const auto index = comp == 0 ? in.solid_u_index : in.solid_v_index;
   const auto alpha = comp == 0 ? in.solid_u_alpha : in.solid_v_alpha;
   const auto us = comp == 0 ? in.solid_u_velocity : in.solid_v_velocity;
+  // The elastic bodies' part of alpha (empty: every body is elastic).
+  const auto elastic = comp == 0 ? in.solid_u_elastic : in.solid_v_elastic;
   const Field& w = comp == 0 ? m_u : m_v;
   const Axis& ax = m_grid.x();
   const Axis& ay = m_grid.y();
@@ -170,7 +176,7 @@ void Solver::sharp_targets(int comp, const CouplingIn& in, std::vector<double>& 
     const double a = alpha[q];
     const bool covered = a >= kCovered;
     target[q] = covered ? us[q] : (1 - a) * w(i, j) + a * us[q];
-    if (a <= kTouched) continue;
+    if (a <= kTouched || elastic.empty() || elastic[q] > kTouched) continue;
     // d alpha / dx_d by central differences (one-sided where a neighbour leaves the faces).
     double g[2];
     for (int d = 0; d < 2; ++d) {
