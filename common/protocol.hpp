@@ -252,7 +252,8 @@ struct FluidInput {  // coupler -> fluid, every step
 
 struct FluidOutput {  // fluid -> coupler, every step
   static constexpr Tag tag = Tag::fluid_output;
-  // f_s = rho_f alpha (u_s - u~)/dt on solid_u / solid_v's faces, same order: force per unit
+  // f_s = rho_f alpha (u_s - u~)/dt (Eq. 21; the fluid's forcing options change the target:
+  // fluid/forcing.cpp) on solid_u / solid_v's faces, same order: force per unit
   // volume ON THE FLUID.
   std::vector<double> fs_u, fs_v;
   std::vector<double> u_sample, v_sample;  // u^(n+1) on sample_u / sample_v

@@ -71,7 +71,7 @@ class Coupler {
   void setup();
   void read_iterations(const fsi::SceneTable& t);
   void check_can_iterate() const;
-  void check_forcing_time() const;
+  void check_immersed_forcing_keys() const;  // fluid.forcing_time, fluid.interface
   void write_effective_scene() const;
   std::string body_names() const;
   // The fibers' feedback force (feedback.cpp).

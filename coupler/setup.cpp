@@ -94,6 +94,8 @@ void Coupler::check_can_iterate() const {
   if (has(Role::solid) && !m_meshes.can_iterate) refuse("solid");
 }
 
+// The immersed forcing's keys against the scene's bodies.
+//
 // fluid.forcing_time blends a cut face by beta, not by the volume fraction alpha (fluid/forcing.cpp),
 // while a body that moves under its load takes the fluid inside it as its own volume times
 // rho_f (Eq. 21's alpha): its inertia would gain sum (beta - alpha) |V| rho_f, and the coupled
@@ -101,11 +103,19 @@ void Coupler::check_can_iterate() const {
 // take no load (fixed or prescribed; solid-rigid's free bodies come as elastic ones). Steady
 // FSI1 with forcing_time = 0 gave u_y(A) +52 % against +12 % (runs/turek-hron-fsi): the held
 // cut faces over the bent bar, not the inertia, which a steady state does not see.
-void Coupler::check_forcing_time() const {
-  if (!has(Role::fluid) || !has(Role::solid)) return;
+//
+// fluid.interface = "sharp" places the walls of fixed bodies; an elastic body's faces keep
+// Eq. 21, known to the fluid by FaceSolid::elastic (fluid/forcing.cpp). A free rigid body takes
+// load but is not elastic there, and a body with a prescribed motion is held by lines that
+// switch as it crosses the cells, each switch a spike in its force (fluid/README.md): both are
+// refused. So is a scene without a fixed body (the key would change nothing), and the smoothed
+// footprint, whose alpha is not a box's area fraction, from which the line places the wall.
+void Coupler::check_immersed_forcing_keys() const {
+  if (!has(Role::fluid)) return;
   const auto fluid = m_rt.root().optional_table("fluid");  // (the fluid checked the keys)
   if (!fluid) return;
-  if (fluid->has("forcing_time")) {
+  const std::string file = m_rt.scene().file().string();
+  if (has(Role::solid) && fluid->has("forcing_time")) {
     const double tau = fluid->number("forcing_time");
     for (const auto& b : m_meshes.bodies)
       if (b.kind == proto::BodyKind::elastic)
@@ -113,37 +123,34 @@ void Coupler::check_forcing_time() const {
             "fluid.forcing_time = {} is for bodies that take no load (rigid bodies, fixed or with "
             "a prescribed motion): body '{}' moves under the fluid's load, and its reaction "
             "assumes the forcing of Eq. 21; remove fluid.forcing_time (in {})",
-            tau, b.name, m_rt.scene().file().string()));
+            tau, b.name, file));
   }
-  // fluid.interface = "sharp" places the walls of fixed bodies; an elastic body's faces keep
-  // Eq. 21, known to the fluid by FaceSolid::elastic (fluid/forcing.cpp). A free rigid body
-  // takes load but is not elastic there, and a body with a prescribed motion is held by lines
-  // that switch as it crosses the cells: an oscillating cylinder's force carried a jitter 16 times
-  // Eq. 21's (fluid/README.md). Both are refused; with no fixed body the key would change nothing.
-  if (fluid->has("interface") && fluid->string("interface") == "sharp") {
-    const std::string file = m_rt.scene().file().string();
-    bool any = false;
-    for (const auto& b : m_meshes.bodies) {
-      if (b.kind == proto::BodyKind::elastic && b.rigid != 0)
-        throw fsi::InputError(fmt::format(
-            "fluid.interface = \"sharp\" places the walls of fixed bodies: body '{}' is a free "
-            "rigid body, which moves under the fluid's load; remove fluid.interface (in {})",
-            b.name, file));
-      if (b.kind == proto::BodyKind::rigid_moving)
-        throw fsi::InputError(fmt::format(
-            "fluid.interface = \"sharp\" places the walls of fixed bodies: body '{}' moves "
-            "([solid.body.motion]), and the faces switching as it crosses the cells put spikes "
-            "into its force (fluid/README.md); remove fluid.interface (in {})",
-            b.name, file));
-      any |= b.kind == proto::BodyKind::rigid_fixed;
-    }
-    if (!any)
+  if (!fluid->has("interface") || fluid->string("interface") != "sharp") return;
+  if (m_footprint_smoothing > 0)
+    throw fsi::InputError(fmt::format(
+        "fluid.interface = \"sharp\" places the wall from each face's area fraction, and "
+        "coupler.footprint_smoothing = {} smooths it; remove one of the two keys (in {})",
+        m_footprint_smoothing, file));
+  bool any = false;
+  for (const auto& b : m_meshes.bodies) {
+    if (b.kind == proto::BodyKind::elastic && b.rigid != 0)
       throw fsi::InputError(fmt::format(
-          "fluid.interface = \"sharp\" places the walls of fixed bodies, and every body of this "
-          "scene moves under the fluid's load (their faces keep Eq. 21); remove fluid.interface "
-          "(in {})",
-          file));
+          "fluid.interface = \"sharp\" places the walls of fixed bodies: body '{}' is a free "
+          "rigid body, which moves under the fluid's load; remove fluid.interface (in {})",
+          b.name, file));
+    if (b.kind == proto::BodyKind::rigid_moving)
+      throw fsi::InputError(fmt::format(
+          "fluid.interface = \"sharp\" places the walls of fixed bodies: body '{}' moves "
+          "([solid.body.motion]), and the faces switching as it crosses the cells put spikes "
+          "into its force (fluid/README.md); remove fluid.interface (in {})",
+          b.name, file));
+    any |= b.kind == proto::BodyKind::rigid_fixed;
   }
+  if (!any)
+    throw fsi::InputError(fmt::format(
+        "fluid.interface = \"sharp\" places the walls of fixed bodies, and this scene has none "
+        "(an elastic body's faces keep Eq. 21); remove fluid.interface (in {})",
+        file));
 }
 
 // Set-up, once: grid from the fluid; meshes and initial state from the solid; layout from the
@@ -198,7 +205,7 @@ void Coupler::setup() {
     if (!m_kappa_given) default_kappa();
   }
   check_can_iterate();
-  check_forcing_time();
+  check_immersed_forcing_keys();
   m_h_min = kFar;
   for (std::size_t i = 0; i + 1 < m_grid.x_face.size(); ++i)
     m_h_min = std::min(m_h_min, m_grid.x_face[i + 1] - m_grid.x_face[i]);

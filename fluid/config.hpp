@@ -105,9 +105,9 @@ struct Config {
   // fluid.interface = "volume" (the default, paper Eq. 21): a cut face blended by its volume
   // fraction; "sharp": a cut face whose centre lies outside the body takes the value on the line
   // from the wall (placed from the face's volume fraction) to the next face out, one whose centre
-  // lies inside the body is extrapolated as a ghost (forcing.cpp, sharp_targets); fixed
-  // bodies' walls only (the coupler refuses the others). Explicit diffusion, one fluid rank,
-  // without forcing_time.
+  // lies inside the body is extrapolated as a ghost (forcing.cpp, sharp_targets); the walls of
+  // fixed bodies (elastic bodies' faces keep Eq. 21; the coupler refuses moving rigid bodies).
+  // Explicit diffusion, one fluid rank, without forcing_time.
   bool sharp_interface = false;
   // Weight of first-order upwind in the convective fluxes outside the sponge (0: central).
   double upwind_blend = 0;

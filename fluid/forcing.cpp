@@ -116,10 +116,10 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
 // fluid face beyond a face whose centre is inside is not listed, and holding that face at u_s
 // would put the wall at its centre. u_s, the body's mean velocity in the box, stands for the
 // wall's.
-// Only the faces of bodies that take no load (no elastic part in alpha) are placed so: an
-// elastic body's faces keep Eq. 21, whose alpha makes the fluid the body carries its own volume
-// (the coupler's solid equation counts on it; with the line on an elastic bar, FSI2 and FSI1
-// diverged: runs/turek-hron-fsi/README.md).
+// Only the faces of rigid bodies (no elastic part in alpha; the coupler admits fixed ones only)
+// are placed so: an elastic body's faces keep Eq. 21, whose alpha makes the fluid the body
+// carries its own volume (the coupler's solid equation counts on it; with the line on an elastic
+// bar, FSI2 and FSI1 diverged: runs/turek-hron-fsi/README.md).
 // A covered face (alpha = 1) is held at u_s, unless the wall runs along its box's edge: its
 // neighbour along d is not touched (alpha_n = 0, so not listed), and it extrapolates as above with
 // the wall at the edge (dist = -h/2). A face with no usable neighbour (alpha not falling along

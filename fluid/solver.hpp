@@ -53,7 +53,8 @@ struct CouplingIn {
   std::span<const std::int32_t> sample_p_index;  // cells i + nx j
 };
 // Output of one step:
-//   solid_*_force: f_s = rho_f alpha (u_s - u~) / dt on the solid's faces, in the input order,
+//   solid_*_force: f_s = rho_f alpha (u_s - u~) / dt on the solid's faces (forcing_time and
+//                  interface = "sharp" change the target: forcing.cpp), in the input order,
 //                  force per unit volume ON THE FLUID (the solid receives its reaction).
 //   sample_*:      u^(n+1) on the requested faces, p^(n+1) in the requested cells, in the
 //                  input order.

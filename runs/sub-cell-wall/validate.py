@@ -42,7 +42,8 @@ _p = cli.parser(__doc__)
 _p.add_argument("--sharp", action="store_true",
                 help="the sharp interface's cases only ([fluid] interface = \"sharp\")")
 ARGS = _p.parse_args()
-OUT = job.out_dir("sub-cell-wall")
+job.out_dir("sub-cell-wall")
+OUT = job.nest("sharp" if ARGS.sharp else None)
 SHORT = ARGS.short
 
 N = 16           # cells across the channel (height 1); the exact profile is linear on any grid

@@ -28,6 +28,7 @@ so both give the same forces here; the README's "none" table was measured before
 (increment, the fluid's default; after_solve: the forcing of the tables measured before it), every
 output under OUT/implicit-forcing-X. `--forcing-time` blends either forcing (the README's
 forcing-time tables before this release took after_solve: `--implicit-forcing after_solve`).
+`--xy-dt DT`: --bands-xy and --xy-shift at this time step (runs named *-dtDT).
 `--interface volume|sharp`: explicit diffusion with fluid.interface written into the scenes
 (volume: the paper's blend, Eq. 21; sharp: the wall placed inside its cell, fluid/forcing.cpp),
 every output under OUT/interface-X; not given: the committed scenes' Crank-Nicolson.
@@ -73,11 +74,16 @@ _p.add_argument("--helmholtz", choices=["direct", "factored"], default="factored
                 help="fluid.helmholtz of the scenes (Crank-Nicolson's Helmholtz solves)")
 cli.body_viscosity(_p, "the scenes")
 cli.implicit_forcing(_p, "the scenes")
+_p.add_argument("--xy-dt", type=float, default=None, metavar="DT",
+                help="--bands-xy (and --xy-shift) at this time step instead of 0.3 h_b s/m "
+                     "(explicit diffusion on 600 x 123 needs it below 3.5e-4)")
 _p.add_argument("--interface", choices=("volume", "sharp"), default=None,
                 help="explicit diffusion with this fluid.interface (outputs under OUT/interface-X)")
 ARGS = _p.parse_args()
 if ARGS.xy_shift and not ARGS.bands_xy:
     _p.error("--xy-shift goes with --bands-xy")
+if ARGS.xy_dt is not None and not ARGS.bands_xy:
+    _p.error("--xy-dt goes with --bands-xy")
 if ARGS.forcing_time is not None and not ARGS.bands_xy:
     _p.error("--forcing-time goes with --bands-xy (the other modes' files are not named by it)")
 SHORT, REUSE = ARGS.short, ARGS.reuse
@@ -510,9 +516,11 @@ if __name__ == "__main__":
         cost()
     elif ARGS.bands_xy and ARGS.xy_shift:
         bands_xy(levels=XY_LEVELS[:ARGS.xy_levels], cases=tuple(ARGS.cases),
-                 out="bands_xy_shift.json", shifts=tuple(ARGS.xy_shift))
+                 out="bands_xy_shift.json", shifts=tuple(ARGS.xy_shift),
+                 dts=[ARGS.xy_dt] if ARGS.xy_dt else None)
     elif ARGS.bands_xy:
-        bands_xy(levels=XY_LEVELS[:ARGS.xy_levels], cases=tuple(ARGS.cases))
+        bands_xy(levels=XY_LEVELS[:ARGS.xy_levels], cases=tuple(ARGS.cases),
+                 dts=[ARGS.xy_dt] if ARGS.xy_dt else None)
     elif ARGS.bands_xy_dt:
         bands_xy(levels=XY_LEVELS[:1], dts=[2.5e-4, 1.25e-4], cases=("cfd1",),
                  out="bands_xy_dt.json")

@@ -183,7 +183,8 @@ TEST_CASE("interface: volume by default, sharp with explicit diffusion only", "[
                     Contains("fluid.interface") && Contains("explicit diffusion") &&
                         Contains("fluid_config_test.toml"));
   CHECK_THROWS_WITH(read(with("interface = \"sharp\"\nforcing_time = 0.0")),
-                    Contains("fluid.interface") && Contains("forcing_time"));
+                    Contains("fluid.interface") && Contains("forcing_time") &&
+                        Contains("fluid_config_test.toml"));
   CHECK_THROWS_WITH(read(with("interface = \"smooth\"")),
                     Contains("interface") && Contains("smooth") && Contains("sharp"));
 }

@@ -541,51 +541,79 @@ double gap(const std::vector<double>& a, const std::vector<double>& b) {
 }  // namespace
 
 namespace {
-// Couette flow over a fixed block: channel [0, 0.25] x [0, 1], periodic in x, 4 x 16 cells, the
-// top wall moving at 1, the block covering y < y0. Each face's alpha is the share of its box
-// below y0 (u: the box spans the cell's rows, v: from centre to centre). Stepped to its steady
-// state: the u profile along a column and the force the block's forcing puts into the fluid,
-// sum of f_s |V| over the faces.
+// Couette flow over a fixed block in a channel of width 1 and length 0.25, periodic along it,
+// 16 cells across and 4 along. The wall at 0 is covered by the block up to y0 (normal = 1: y
+// across, u the flow, the family whose lines run across its own rows) or x0 (normal = 0: x
+// across, v the flow, its lines along x, across the v boxes' columns); the far wall moves at 1
+// along the channel. Each face's alpha is the share of its box below y0 (x0): the box spans the
+// cell across for the flow's family, from centre to centre for the other. stretched: across,
+// 10 of the 16 cells evenly over [0.5, 1] and 6 growing towards the block's wall at 0, so the
+// wall lies in graded cells. Stepped to its steady state: the flow's profile across, and the
+// force the block's forcing puts into the fluid, sum of f_s |V| over the faces.
 struct Couette {
   std::vector<double> u, y;
   double force = 0;
 };
-Couette couette_over_block(double y0, bool sharp, bool elastic = false) {
+Couette couette_over_block(double y0, bool sharp, bool elastic = false, int normal = 1,
+                           bool stretched = false) {
   Config c = box(BcType::periodic);
   c.density = 1;
   c.viscosity = 0.05;
-  c.x = {4, 0.25, 0.0};
-  c.y = {16, 1.0, 0.0};
-  c.bc[top].velocity = 1.0;
+  AxisSpec across{16, 1.0, 0.0}, along{4, 0.25, 0.0};
+  if (stretched) across.band_cells = 10, across.band_from = 0.5, across.band_to = 1.0;
+  c.x = normal == 1 ? along : across;
+  c.y = normal == 1 ? across : along;
+  for (auto& b : c.bc) b.type = BcType::periodic;
+  const Side lo = normal == 1 ? bottom : left, hi = normal == 1 ? top : right;
+  c.bc[lo].type = c.bc[hi].type = BcType::wall;
+  c.bc[hi].velocity = 1.0;
   c.sharp_interface = sharp;
-  const double h = 1.0 / 16, dt = 0.1 * h * h / c.viscosity;  // lambda = 0.1
+  Solver probe(c, 1e-6);
+  const Grid& g = probe.grid();
+  const Axis& ax = normal == 1 ? g.y() : g.x();
+  double hmin = 1;
+  for (int k = 0; k < ax.n(); ++k) hmin = std::min(hmin, ax.width(k));
+  const double dt = 0.1 * hmin * hmin / c.viscosity;  // lambda = 0.1 on the smallest cell
   Solver s(c, dt);
-  const Grid& g = s.grid();
-  auto share = [&](double lo, double hi) { return std::clamp((y0 - lo) / (hi - lo), 0.0, 1.0); };
-  std::vector<std::int32_t> iu, iv;
-  std::vector<double> au, av;
-  for (int j = 0; j < g.ny(); ++j) {
-    const double a = share(g.y().face(j), g.y().face(j + 1));
-    if (a > 0)
-      for (int i = 0; i < g.nu(); ++i) iu.push_back(i + g.nu() * j), au.push_back(a);
+  auto share = [&](double a, double b) { return std::clamp((y0 - a) / (b - a), 0.0, 1.0); };
+  // Faces (i, j) of family comp (0 = u, 1 = v) with their alpha and box volume.
+  std::vector<std::int32_t> idx[2];
+  std::vector<double> al[2], vol[2];
+  for (int comp = 0; comp < 2; ++comp) {
+    const int ni = comp == 0 ? g.nu() : g.nx(), nj = comp == 0 ? g.ny() : g.nv();
+    for (int j = 0; j < nj; ++j)
+      for (int i = 0; i < ni; ++i) {
+        // The unknowns only: across a wall the first and last faces of the family across it.
+        const int k = normal == 1 ? j : i;
+        const bool own = comp == normal;  // the family whose faces lie on lines across
+        if (own && (k == 0 || k == ax.n())) continue;
+        const double bx0 = comp == 0 ? g.x().centre(i - 1) : g.x().face(i);
+        const double bx1 = comp == 0 ? g.x().centre(i) : g.x().face(i + 1);
+        const double by0 = comp == 0 ? g.y().face(j) : g.y().centre(j - 1);
+        const double by1 = comp == 0 ? g.y().face(j + 1) : g.y().centre(j);
+        const double a = normal == 1 ? share(by0, by1) : share(bx0, bx1);
+        if (a <= 0) continue;
+        idx[comp].push_back(i + ni * j), al[comp].push_back(a);
+        vol[comp].push_back((bx1 - bx0) * (by1 - by0));
+      }
   }
-  for (int j = 1; j < g.ny(); ++j) {  // the v unknowns
-    const double a = share(g.y().centre(j - 1), g.y().centre(j));
-    if (a > 0)
-      for (int i = 0; i < g.nx(); ++i) iv.push_back(i + g.nx() * j), av.push_back(a);
-  }
-  const std::vector<double> zu(iu.size(), 0.0), zv(iv.size(), 0.0);
-  CouplingIn in = solid_input(iu, au, zu, iv, av, zv);
+  const std::vector<double> zu(idx[0].size(), 0.0), zv(idx[1].size(), 0.0);
+  CouplingIn in = solid_input(idx[0], al[0], zu, idx[1], al[1], zv);
   // The block rigid (no elastic part: its wall placed) or elastic (its faces keep Eq. 21).
-  in.solid_u_elastic = elastic ? std::span<const double>(au) : std::span<const double>(zu);
-  in.solid_v_elastic = elastic ? std::span<const double>(av) : std::span<const double>(zv);
+  in.solid_u_elastic = elastic ? std::span<const double>(al[0]) : std::span<const double>(zu);
+  in.solid_v_elastic = elastic ? std::span<const double>(al[1]) : std::span<const double>(zv);
   CouplingOut out;
   // 2.5 diffusion times of the layer above the block.
   const int steps = int(std::lround(2.5 / c.viscosity / dt));
   for (int n = 0; n < steps; ++n) s.step(dt, in, out);
   Couette r;
-  for (int j = 0; j < g.ny(); ++j) r.u.push_back(s.u()(2, j)), r.y.push_back(g.y().centre(j));
-  for (double f : out.solid_u_force) r.force += f * h * h;
+  for (int k = 0; k < ax.n(); ++k) {
+    r.u.push_back(normal == 1 ? s.u()(2, k) : s.v()(k, 2));
+    r.y.push_back(ax.centre(k));
+  }
+  const auto& f = normal == 1 ? out.solid_u_force : out.solid_v_force;
+  const int flow = normal == 1 ? 0 : 1;
+  for (std::size_t q = 0; q < f.size(); ++q) r.force += f[q] * vol[flow][q];
   return r;
 }
 }  // namespace
@@ -594,29 +622,120 @@ Couette couette_over_block(double y0, bool sharp, bool elastic = false) {
 // wall through the next face holds on any grid: every face above the block exact, and the force
 // on the fluid the wall's shear, -mu/(1 - y0) per unit length over the 0.25 of the channel. The
 // paper's blend puts the wall up to half a cell off (runs/sub-cell-wall), which these checks see.
-// The block is rigid; an elastic one is left to Eq. 21.
+// The block is rigid; an elastic one is left to Eq. 21. Both families: u faces with lines across
+// their rows (normal y), v faces with lines across the v boxes (normal x), uniform and with the
+// wall in graded cells.
 TEST_CASE("interface = sharp: a wall anywhere in its cell, a linear profile held exactly",
           "[fluid][coupling]") {
-  for (double delta : {0.0, 0.1, 0.5, 0.8}) {
-    CAPTURE(delta);
-    const double y0 = (4 + delta) / 16.0;
-    const Couette sharp = couette_over_block(y0, true), volume = couette_over_block(y0, false);
-    double err = 0, err_volume = 0;
-    for (std::size_t j = 0; j < sharp.u.size(); ++j) {
-      if (sharp.y[j] <= y0) continue;
-      const double exact = (sharp.y[j] - y0) / (1 - y0);
-      err = std::max(err, std::abs(sharp.u[j] - exact));
-      err_volume = std::max(err_volume, std::abs(volume.u[j] - exact));
+  for (int normal : {1, 0})
+    for (bool stretched : {false, true})
+      for (double delta : {0.0, 0.1, 0.5, 0.8}) {
+        CAPTURE(normal, stretched, delta);
+        // The wall delta of the way across the cell that holds 0.25 + a bit.
+        double y0 = 0;
+        {
+          Config c = box(BcType::periodic);
+          AxisSpec across{16, 1.0, 0.0};
+          if (stretched) across.band_cells = 10, across.band_from = 0.5, across.band_to = 1.0;
+          const Axis ax(across);
+          int k = 0;
+          while (ax.face(k + 1) < 0.25) ++k;
+          y0 = ax.face(k) + delta * ax.width(k);
+        }
+        const Couette sharp = couette_over_block(y0, true, false, normal, stretched);
+        const Couette volume = couette_over_block(y0, false, false, normal, stretched);
+        double err = 0, err_volume = 0;
+        for (std::size_t j = 0; j < sharp.u.size(); ++j) {
+          if (sharp.y[j] <= y0) continue;
+          const double exact = (sharp.y[j] - y0) / (1 - y0);
+          err = std::max(err, std::abs(sharp.u[j] - exact));
+          err_volume = std::max(err_volume, std::abs(volume.u[j] - exact));
+        }
+        CHECK(err < 1e-8);
+        CHECK(err_volume > 1e-3);
+        // The force on uniform grids only: on graded cells the fluid's Laplacian across them is
+        // in finite-difference form (2/(c_(j+1) - c_(j-1)) where a balance over the boxes would
+        // take 1/w_j), so the forcing summed over the boxes is not the momentum balance there
+        // (measured here: -0.48 %, -19 % with the wall on a grid line; Eq. 21 -0.8 ... -6.4 %).
+        const double shear = -0.05 / (1 - y0) * 0.25;
+        if (!stretched) CHECK(sharp.force == Approx(shear).epsilon(1e-6));
+        // An elastic block's faces keep Eq. 21: the volume blend's steady state to round-off
+        // (the update is written differently; an elastic body's viscosity taken out in both,
+        // body_viscosity = "none").
+        CHECK(gap(couette_over_block(y0, true, true, normal, stretched).u,
+                  couette_over_block(y0, false, true, normal, stretched).u) < 1e-12);
+      }
+}
+
+// A block over rows 0..2 of the box, cut in row 3 (alpha 0.6) and in every other face of row 4
+// (alpha 0.2), at rest, in the body-force-driven periodic channel; its steady u along a column
+// after t = 150 at time step dt. Row 3's faces at odd i read row 4's cut faces, which are forced
+// themselves: read at their targets, every target depends on velocities alone, so the steady
+// state does not depend on dt (read at their predictors, the slip dt R of a forced face would
+// enter).
+std::vector<double> steady_sharp_block(double dt) {
+  Config c = box(BcType::periodic);
+  c.body = {2.0, 0.0};
+  c.sharp_interface = true;
+  Solver s(c, dt);
+  const int nu = s.grid().nu();
+  std::vector<std::int32_t> iu;
+  std::vector<double> au, zero;
+  for (int j = 0; j < 5; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const double a = j < 3 ? 1.0 : j == 3 ? 0.6 : (i % 2 ? 0.2 : 0.0);
+      if (a > 0) iu.push_back(i + nu * j), au.push_back(a), zero.push_back(0);
     }
-    CHECK(err < 1e-8);
-    CHECK(err_volume > 1e-3);
-    const double shear = -0.05 / (1 - y0) * 0.25;
-    CHECK(sharp.force == Approx(shear).epsilon(1e-6));
-    // An elastic block's faces keep Eq. 21: the volume blend's steady state to round-off (the
-    // update is written differently; an elastic body's viscosity taken out in both,
-    // body_viscosity = "none").
-    CHECK(gap(couette_over_block(y0, true, true).u, couette_over_block(y0, false, true).u) < 1e-12);
-  }
+  CouplingIn in;
+  in.solid_u_index = iu;
+  in.solid_u_alpha = au;
+  in.solid_u_velocity = zero;
+  in.solid_u_elastic = zero;
+  CouplingOut out;
+  const int steps = static_cast<int>(std::lround(150.0 / dt));
+  for (int n = 0; n < steps; ++n) s.step(dt, in, out);
+  std::vector<double> u;
+  for (int j = 0; j < s.grid().ny(); ++j) u.push_back(s.u()(3, j)), u.push_back(s.u()(4, j));
+  return u;
+}
+
+TEST_CASE("interface = sharp: a forced neighbour read at its target, no slip of order dt",
+          "[fluid][coupling]") {
+  // lambda = 0.10 and 0.05 (dt = 0.04, 0.02), as the forcing_time test above.
+  const auto coarse = steady_sharp_block(0.04), fine = steady_sharp_block(0.02);
+  CHECK(coarse[2 * 5] > 0.1);  // the flow above the block (row 5)
+  CHECK(gap(coarse, fine) < 1e-10);
+}
+
+// A redo with the step's own input gives the step's fields and force bit for bit: the lines
+// are built afresh from the kept predictor, nothing of the first pass stays behind.
+TEST_CASE("interface = sharp: a redo with the same input repeats the step", "[fluid][coupling]") {
+  Config c = box(BcType::periodic);
+  c.sharp_interface = true;
+  const double dt = 1e-3;
+  Solver s(c, dt);
+  const int nu = s.grid().nu();
+  // A block over rows 0..2 and cut in row 3 (alpha 0.6 and 0.2 along it), moving at 0.2: covered
+  // faces that extrapolate, cut ones that interpolate, a forced neighbour read at its target.
+  std::vector<std::int32_t> iu;
+  std::vector<double> au, uu, zero;
+  for (int j = 0; j < 5; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const double a = j < 3 ? 1.0 : j == 3 ? 0.6 : (i % 2 ? 0.2 : 0.0);
+      if (a > 0) iu.push_back(i + nu * j), au.push_back(a), uu.push_back(0.2), zero.push_back(0);
+    }
+  CouplingIn in;
+  in.solid_u_index = iu;
+  in.solid_u_alpha = au;
+  in.solid_u_velocity = uu;
+  in.solid_u_elastic = zero;
+  CouplingOut out, out2;
+  for (int n = 0; n < 3; ++n) s.step(dt, in, out);
+  const Field u1 = s.u(), p1 = s.p();
+  s.redo_step(dt, in, out2);
+  CHECK(out2.solid_u_force == out.solid_u_force);
+  CHECK(s.u().a == u1.a);
+  CHECK(s.p().a == p1.a);
 }
 
 TEST_CASE("forcing_time: a steady flow's slip in cut faces does not depend on dt",
