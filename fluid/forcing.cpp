@@ -176,7 +176,6 @@ void Solver::sharp_targets(int comp, const CouplingIn& in, std::vector<double>& 
     const double a = alpha[q];
     const bool covered = a >= kCovered;
     target[q] = covered ? us[q] : (1 - a) * w(i, j) + a * us[q];
-    lines[q] = SharpLine{};
     if (a <= kTouched || elastic.empty() || elastic[q] > kTouched) continue;
     // d alpha / dx_d by central differences (one-sided where a neighbour leaves the faces).
     double g[2];
@@ -191,33 +190,24 @@ void Solver::sharp_targets(int comp, const CouplingIn& in, std::vector<double>& 
       const double xm = km < 0 ? pos(d, k) : pos(d, k - 1);
       g[d] = xp > xm ? (at(kp) - at(km)) / (xp - xm) : 0.0;
     }
-    // The line along each direction d with a gradient, weighted by g_d^2 (the normal's share).
-    SharpLine& L = lines[q];
-    double wsum = 0;
-    for (int d = 0; d < 2; ++d) {
-      if (g[d] == 0) continue;
-      const int s = g[d] < 0 ? 1 : -1;
-      const int k = d == 0 ? i : j;
-      const auto [lo, hi] = box(d, k);
-      const double xw = s > 0 ? lo + a * (hi - lo) : hi - a * (hi - lo);
-      const double dist = s * (pos(d, k) - xw);
-      const int kn = along(d, k, s);
-      if (kn < 0) continue;
-      const int in_ = d == 0 ? kn : i, jn = d == 0 ? j : kn;
-      if (in_ < ilo || in_ >= ihi || jn < jlo || jn >= jhi) continue;
-      const double an = amap[in_ + std::size_t(ni) * jn];
-      if (an >= a || an > 0.25 || (covered && an > kTouched)) continue;
-      // The neighbour's coordinate unwrapped (one face on from k, across a periodic seam too).
-      const double span = s * (pos(d, k + s) - xw);
-      if (span <= 0) continue;
-      L.i[d] = in_, L.j[d] = jn, L.r[d] = dist / span, L.w[d] = g[d] * g[d];
-      wsum += L.w[d];
-    }
-    if (wsum == 0) continue;
-    double t = us[q];
-    for (int d = 0; d < 2; ++d)
-      if (L.w[d] > 0) L.w[d] /= wsum, t += L.w[d] * L.r[d] * (w(L.i[d], L.j[d]) - us[q]);
-    target[q] = t;
+    const int d = std::abs(g[0]) >= std::abs(g[1]) ? 0 : 1;
+    if (g[d] == 0) continue;
+    const int s = g[d] < 0 ? 1 : -1;
+    const int k = d == 0 ? i : j;
+    const auto [lo, hi] = box(d, k);
+    const double xw = s > 0 ? lo + a * (hi - lo) : hi - a * (hi - lo);
+    const double dist = s * (pos(d, k) - xw);
+    const int kn = along(d, k, s);
+    if (kn < 0) continue;
+    const int in_ = d == 0 ? kn : i, jn = d == 0 ? j : kn;
+    if (in_ < ilo || in_ >= ihi || jn < jlo || jn >= jhi) continue;
+    const double an = amap[in_ + std::size_t(ni) * jn];
+    if (an >= a || an > 0.25 || (covered && an > kTouched)) continue;
+    // The neighbour's coordinate unwrapped (one face on from k, across a periodic seam too).
+    const double span = s * (pos(d, k + s) - xw);
+    if (span <= 0) continue;
+    lines[q] = {in_, jn, dist / span};
+    target[q] = us[q] + (w(in_, jn) - us[q]) * lines[q].r;
   }
   // A neighbour that is itself forced (a cut face, alpha_n <= 1/4) takes its own target, not
   // its predictor: in a steady flow the predictor of a forced face differs from its velocity by
@@ -228,15 +218,9 @@ void Solver::sharp_targets(int comp, const CouplingIn& in, std::vector<double>& 
   first.assign(target.begin(), target.end());
   for (std::size_t q = 0; q < index.size(); ++q) {
     const SharpLine& l = lines[q];
-    bool again = false;
-    double t = us[q];
-    for (int d = 0; d < 2; ++d) {
-      if (l.w[d] <= 0) continue;
-      const std::int32_t qn = slot[l.i[d] + std::size_t(ni) * l.j[d]];
-      again |= qn >= 0;
-      t += l.w[d] * l.r[d] * ((qn >= 0 ? first[qn] : w(l.i[d], l.j[d])) - us[q]);
-    }
-    if (again) target[q] = t;
+    if (l.i < 0) continue;
+    const std::int32_t qn = slot[l.i + std::size_t(ni) * l.j];
+    if (qn >= 0) target[q] = us[q] + (first[qn] - us[q]) * l.r;
   }
   for (std::size_t q = 0; q < index.size(); ++q) amap[index[q]] = 0.0, slot[index[q]] = -1;
 }

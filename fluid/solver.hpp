@@ -250,9 +250,9 @@ class Solver {
   // and -1 between steps), the step's targets, and sharp_targets' scratch.
   std::array<std::vector<double>, 2> m_sharp_alpha, m_sharp_target, m_sharp_first;
   std::array<std::vector<std::int32_t>, 2> m_sharp_slot;
-  struct SharpLine {  // per direction d: the neighbour (i, j) its line reads, the line's
-    int i[2] = {-1, -1}, j[2] = {-1, -1};  // weight dist / span, and the direction's weight
-    double r[2] = {0, 0}, w[2] = {0, 0};   // (0: no line along d)
+  struct SharpLine {
+    int i = -1, j = -1;  // the neighbour the face's line reads (i = -1: none)
+    double r = 0;        // its weight, dist / span
   };
   std::array<std::vector<SharpLine>, 2> m_sharp_lines;
   // body_viscosity = "none": the elastic bodies' volume fraction per u, v face, zero
