@@ -102,16 +102,18 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
 // |d alpha/dx_d| is largest, with s = +1 when the fluid lies towards +x_d (alpha falls that way),
 // the wall crosses the face's own grid line at
 //   x_w = lo + alpha (hi - lo)  (s = +1),   x_w = hi - alpha (hi - lo)  (s = -1),
-// [lo, hi] the box along d: exact for a straight wall across the box's middle band (the box's
-// area fraction is then the fraction of its centre line, on whichever side; the box's own
-// centre line along d is the face's, which is where the face's velocity lives). With x_f the
+// [lo, hi] the box along d: exact for a straight wall across the box's middle band at right
+// angles to d (the box's area fraction is then the fraction of its centre line, on whichever
+// side; on even cells the box's own centre line along d is the face's, where the face's
+// velocity lives; on graded ones a slanted wall is placed off by a fraction of the cells'
+// difference). With x_f the
 // face and x_n its neighbour one face further into the fluid, dist = s (x_f - x_w) (in about
 // [-h/2, h/2]: the box meets the wall),
 //   u = u_s + (u~_n - u_s) dist / (s (x_n - x_w)),
 // the line from the wall's velocity at x_w through the fluid's at x_n: an interpolation when the
 // face's centre is in the fluid (Fadlun et al. 2000, J. Comput. Phys. 161, 35, along one grid
-// direction), an extrapolation into the body when it is inside (weight on u~_n down to -1), as a
-// ghost cell. Either way the faces hold a linear profile whatever the wall's place in the cell:
+// direction), an extrapolation into the body when it is inside (weight on u~_n down to -1 on
+// even cells, below it where cells shrink towards the fluid), as a ghost cell. Either way the faces hold a linear profile whatever the wall's place in the cell:
 // the faces a box-based footprint lists are those within half a cell of the wall, so the first
 // fluid face beyond a face whose centre is inside is not listed, and holding that face at u_s
 // would put the wall at its centre. u_s, the body's mean velocity in the box, stands for the
@@ -122,9 +124,13 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
 // bar, FSI2 and FSI1 diverged: runs/turek-hron-fsi/README.md).
 // A covered face (alpha = 1) is held at u_s, unless the wall runs along its box's edge: its
 // neighbour along d is not touched (alpha_n = 0, so not listed), and it extrapolates as above with
-// the wall at the edge (dist = -h/2). A face with no usable neighbour (alpha not falling along
-// d, the neighbour a boundary face or no lower alpha) keeps the paper's blend,
+// the wall at the edge (dist = -h/2). A face with no usable neighbour (the neighbour a boundary
+// face, as covered as the face, or more than a quarter covered: half inside the body at a
+// concave corner, no fluid value to draw a line through) keeps the paper's blend,
 // (1 - alpha) u~ + alpha u_s; so does a face without a gradient (a sliver inside one box).
+// At a convex corner the line of the larger gradient may run along x on one corner and along y
+// on its mirror image; the lift of the Turek-Hron obstacle moves with the cells' alignment
+// (runs/turek-hron-cfd/README.md, "The sharp interface").
 void Solver::sharp_targets(int comp, const CouplingIn& in, std::vector<double>& target) {
   const auto index = comp == 0 ? in.solid_u_index : in.solid_v_index;
   const auto alpha = comp == 0 ? in.solid_u_alpha : in.solid_v_alpha;
