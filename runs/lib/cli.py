@@ -29,6 +29,14 @@ def body_divergence(p, what):
                         "own), outputs under OUT/.../body-divergence-X")
 
 
+def interface(p, what):
+    """The --interface option of a case whose runs WHAT ([fluid] interface written into its
+    scenes; not given: the fluid's default, "volume", Eq. 21)."""
+    p.add_argument("--interface", choices=("volume", "sharp"), default=None,
+                   help=f"[fluid] interface of {what} (default: not written, the fluid's volume), "
+                        "outputs under OUT/.../interface-X")
+
+
 def implicit_forcing(p, what):
     """The --implicit-forcing option of a case whose runs WHAT with Crank-Nicolson ([fluid]
     implicit_forcing written into its scenes; not given: the fluid's default, "increment")."""

@@ -38,10 +38,9 @@ P = cli.parser(__doc__)
 P.add_argument("--grids", type=cli.ints, default=None,
                help="cells across the box's height, e.g. 16,32,64 (default: 16,32,64; "
                     "--short: 16,32)")
-P.add_argument("--interface", choices=("volume", "sharp"), default=None,
-               help="[fluid] interface of the channels (the tilted slab and the hydrostatic box "
-                    "move, which the sharp interface refuses: not run), outputs under "
-                    "OUT/interface-X")
+# The tilted slab and the hydrostatic box move, which the sharp interface refuses: with
+# --interface they are not run.
+cli.interface(P, "the channels")
 ARGS = P.parse_args()
 SHORT = ARGS.short
 job.out_dir("surface-probes")

@@ -77,8 +77,7 @@ cli.implicit_forcing(_p, "the scenes")
 _p.add_argument("--xy-dt", type=float, default=None, metavar="DT",
                 help="--bands-xy (and --xy-shift) at this time step instead of 0.3 h_b s/m "
                      "(explicit diffusion on 600 x 123 needs it below 3.5e-4)")
-_p.add_argument("--interface", choices=("volume", "sharp"), default=None,
-                help="explicit diffusion with this fluid.interface (outputs under OUT/interface-X)")
+cli.interface(_p, "the scenes, with explicit diffusion")
 ARGS = _p.parse_args()
 if ARGS.xy_shift and not ARGS.bands_xy:
     _p.error("--xy-shift goes with --bands-xy")

@@ -89,9 +89,7 @@ _p.add_argument("--fsi1-shift-level", choices=["XY123", "XY152", "XY184"], defau
                      "760 x 152, 920 x 184; default XY123)")
 _p.add_argument("--reuse", action="store_true", help="keep finished runs of identical scenes")
 cli.body_viscosity(_p, "every run")
-_p.add_argument("--interface", choices=("volume", "sharp"), default=None,
-                help="fluid.interface of every run (default: not written, the fluid's volume), "
-                     "outputs under OUT/interface-X")
+cli.interface(_p, "every run")
 ARGS = _p.parse_args()
 # --ci: L2 only, the frequency judged against the refined values and reported against the 2006
 # table's 2.0 Hz, which this method misses by 3.4-3.5 % on every level (README, "Frequency").

@@ -554,13 +554,17 @@ struct Couette {
   std::vector<double> u, y;
   double force = 0;
 };
+AxisSpec couette_across(bool stretched) {
+  AxisSpec across{16, 1.0, 0.0};
+  if (stretched) across.band_cells = 10, across.band_from = 0.5, across.band_to = 1.0;
+  return across;
+}
 Couette couette_over_block(double y0, bool sharp, bool elastic = false, int normal = 1,
                            bool stretched = false) {
   Config c = box(BcType::periodic);
   c.density = 1;
   c.viscosity = 0.05;
-  AxisSpec across{16, 1.0, 0.0}, along{4, 0.25, 0.0};
-  if (stretched) across.band_cells = 10, across.band_from = 0.5, across.band_to = 1.0;
+  const AxisSpec across = couette_across(stretched), along{4, 0.25, 0.0};
   c.x = normal == 1 ? along : across;
   c.y = normal == 1 ? across : along;
   for (auto& b : c.bc) b.type = BcType::periodic;
@@ -568,13 +572,13 @@ Couette couette_over_block(double y0, bool sharp, bool elastic = false, int norm
   c.bc[lo].type = c.bc[hi].type = BcType::wall;
   c.bc[hi].velocity = 1.0;
   c.sharp_interface = sharp;
-  Solver probe(c, 1e-6);
-  const Grid& g = probe.grid();
-  const Axis& ax = normal == 1 ? g.y() : g.x();
+  const Axis a(across);
   double hmin = 1;
-  for (int k = 0; k < ax.n(); ++k) hmin = std::min(hmin, ax.width(k));
+  for (int k = 0; k < a.n(); ++k) hmin = std::min(hmin, a.width(k));
   const double dt = 0.1 * hmin * hmin / c.viscosity;  // lambda = 0.1 on the smallest cell
   Solver s(c, dt);
+  const Grid& g = s.grid();
+  const Axis& ax = normal == 1 ? g.y() : g.x();
   auto share = [&](double a, double b) { return std::clamp((y0 - a) / (b - a), 0.0, 1.0); };
   // Faces (i, j) of family comp (0 = u, 1 = v) with their alpha and box volume.
   std::vector<std::int32_t> idx[2];
@@ -632,16 +636,10 @@ TEST_CASE("interface = sharp: a wall anywhere in its cell, a linear profile held
       for (double delta : {0.0, 0.1, 0.5, 0.8}) {
         CAPTURE(normal, stretched, delta);
         // The wall delta of the way across the cell that holds 0.25 + a bit.
-        double y0 = 0;
-        {
-          Config c = box(BcType::periodic);
-          AxisSpec across{16, 1.0, 0.0};
-          if (stretched) across.band_cells = 10, across.band_from = 0.5, across.band_to = 1.0;
-          const Axis ax(across);
-          int k = 0;
-          while (ax.face(k + 1) < 0.25) ++k;
-          y0 = ax.face(k) + delta * ax.width(k);
-        }
+        const Axis ax(couette_across(stretched));
+        int k = 0;
+        while (ax.face(k + 1) < 0.25) ++k;
+        const double y0 = ax.face(k) + delta * ax.width(k);
         const Couette sharp = couette_over_block(y0, true, false, normal, stretched);
         const Couette volume = couette_over_block(y0, false, false, normal, stretched);
         double err = 0, err_volume = 0;
