@@ -128,9 +128,15 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
 // face, as covered as the face, or more than a quarter covered: half inside the body at a
 // concave corner, no fluid value to draw a line through) keeps the paper's blend,
 // (1 - alpha) u~ + alpha u_s; so does a face without a gradient (a sliver inside one box).
-// At a convex corner the line of the larger gradient may run along x on one corner and along y
-// on its mirror image; the lift of the Turek-Hron obstacle moves with the cells' alignment
-// (runs/turek-hron-cfd/README.md, "The sharp interface").
+// So does a face whose box holds a convex corner of two walls along the grid directions (a
+// rectangle's end: alpha = f_x f_y with both fractions partial, recognised from its neighbours
+// into the body, at_corner below). Its line would have to choose one wall: the larger gradient
+// ran along x at one corner of the Turek-Hron bar's trailing edge and along y at its mirror
+// image, and placed that wall at alpha instead of its own fraction; the asymmetry moved the
+// circulation, so the lift with the cells moved by a quarter of a cell was +11.5 % (CFD1) and
+// +18.1 % (CFD2) with such lines, +1.2 % and +3.4 % with the blend there
+// (runs/turek-hron-cfd/README.md, "The sharp interface"). A corner between walls not along the
+// grid directions is not recognised and keeps its line.
 void Solver::sharp_targets(int comp, const CouplingIn& in, std::vector<double>& target) {
   const auto index = comp == 0 ? in.solid_u_index : in.solid_v_index;
   const auto alpha = comp == 0 ? in.solid_u_alpha : in.solid_v_alpha;
@@ -173,6 +179,17 @@ void Solver::sharp_targets(int comp, const CouplingIn& in, std::vector<double>& 
     if (per[a]) return (k + n) % n;
     return k < 0 || k >= n ? -1 : k;
   };
+  // Whether the face's box holds a convex corner of two walls along the grid directions: the
+  // box is cut along x by the fraction f_x and along y by f_y, so alpha = f_x f_y, and its
+  // neighbour one face into the body along x (cut along y only: f_y) and along y (f_x) are
+  // partly covered with alpha_x alpha_y = alpha. g: d alpha / dx_d, both non-zero (the body lies
+  // where alpha rises).
+  auto at_corner = [&](int i, int j, double a, const double* g) {
+    const int ki = along(0, i, g[0] > 0 ? 1 : -1), kj = along(1, j, g[1] > 0 ? 1 : -1);
+    if (ki < 0 || kj < 0) return false;
+    const double bx = amap[ki + std::size_t(ni) * j], by = amap[i + std::size_t(ni) * kj];
+    return bx < kCovered && by < kCovered && std::abs(a - bx * by) <= kTouched;
+  };
   // Each face's line: its neighbour (i, j) and the weight dist / span, or none (i = -1).
   std::vector<SharpLine>& lines = m_sharp_lines[comp];
   lines.assign(index.size(), SharpLine{});
@@ -198,6 +215,7 @@ void Solver::sharp_targets(int comp, const CouplingIn& in, std::vector<double>& 
     }
     const int d = std::abs(g[0]) >= std::abs(g[1]) ? 0 : 1;
     if (g[d] == 0) continue;
+    if (!covered && g[1 - d] != 0 && at_corner(i, j, a, g)) continue;
     const int s = g[d] < 0 ? 1 : -1;
     const int k = d == 0 ? i : j;
     const auto [lo, hi] = box(d, k);

@@ -705,6 +705,58 @@ TEST_CASE("interface = sharp: a forced neighbour read at its target, no slip of 
   CHECK(gap(coarse, fine) < 1e-10);
 }
 
+// A block at rest in a uniform stream U (periodic in x; rows 1..6 untouched by the walls, so
+// u~ = U there exactly), its edges at 3/4 and 1/4 of their cells: x in [4.25 h, 8.75 h], y in
+// [2.75 h, 5.75 h]. Each u face's target is read back from its force, target = u~ + dt f / rho.
+// The four faces whose boxes hold a corner keep Eq. 21 (target (1 - alpha) U); the faces cut by
+// one wall take the line through their neighbour (target r U, r = dist / span).
+TEST_CASE("interface = sharp: a convex corner keeps Eq. 21, a side its line", "[fluid][coupling]") {
+  Config c = box(BcType::periodic);
+  c.sharp_interface = true;
+  const double dt = 1e-3, U = 0.4;
+  Solver s(c, dt);
+  const int nu = s.grid().nu();
+  const double h = 1.0 / 16;
+  for (int j = 0; j < s.grid().ny(); ++j)
+    for (int i = 0; i < nu; ++i) s.u()(i, j) = U;
+  auto overlap = [](double lo, double hi, double a, double b) {
+    return std::max(0.0, std::min(hi, b) - std::max(lo, a));
+  };
+  const double x0 = 4.25 * h, x1 = 8.75 * h, y0 = 2.75 * h, y1 = 5.75 * h;
+  std::vector<std::int32_t> iu;
+  std::vector<double> au, zero;
+  for (int j = 0; j < s.grid().ny(); ++j)
+    for (int i = 0; i < nu; ++i) {
+      const double a = overlap((i - 0.5) * h, (i + 0.5) * h, x0, x1) / h *
+                       overlap(j * h, (j + 1) * h, y0, y1) / h;
+      if (a > 0) iu.push_back(i + nu * j), au.push_back(a), zero.push_back(0);
+    }
+  CouplingIn in;
+  in.solid_u_index = iu;
+  in.solid_u_alpha = au;
+  in.solid_u_velocity = zero;
+  in.solid_u_elastic = zero;
+  CouplingOut out;
+  s.step(dt, in, out);
+  auto target = [&](int i, int j) {
+    const auto q = std::find(iu.begin(), iu.end(), i + nu * j) - iu.begin();
+    REQUIRE(std::size_t(q) < iu.size());
+    return U + dt * out.solid_u_force[q] / c.density;
+  };
+  // The corners: alpha = f_x f_y.
+  CHECK(target(9, 5) == Approx((1 - 0.25 * 0.75) * U).epsilon(1e-12));
+  CHECK(target(9, 2) == Approx((1 - 0.25 * 0.25) * U).epsilon(1e-12));
+  CHECK(target(4, 5) == Approx((1 - 0.25 * 0.75) * U).epsilon(1e-12));
+  CHECK(target(4, 2) == Approx((1 - 0.25 * 0.25) * U).epsilon(1e-12));
+  // The tip (x = 9 h, wall 0.25 h behind, neighbour at 10 h), the left end (x = 4 h, wall
+  // 0.25 h ahead), the top (y = 5.5 h inside, wall 0.25 h above, neighbour at 6.5 h) and the
+  // bottom (y = 2.5 h, wall 0.25 h above, neighbour at 1.5 h).
+  CHECK(target(9, 4) == Approx(0.2 * U).epsilon(1e-12));
+  CHECK(target(4, 4) == Approx(0.2 * U).epsilon(1e-12));
+  CHECK(target(6, 5) == Approx(-U / 3).epsilon(1e-12));
+  CHECK(target(6, 2) == Approx(0.2 * U).epsilon(1e-12));
+}
+
 // A redo with the step's own input gives the step's fields and force bit for bit: the lines
 // are built afresh from the kept predictor, nothing of the first pass stays behind.
 TEST_CASE("interface = sharp: a redo with the same input repeats the step", "[fluid][coupling]") {
