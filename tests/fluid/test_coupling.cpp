@@ -665,6 +665,27 @@ TEST_CASE("interface = sharp: a wall anywhere in its cell, a linear profile held
       }
 }
 
+// A fixed rigid body's u faces: those of rows 0 .. rows - 1 with a(i, j) > 0, at rest, no
+// elastic part (`in` spans the vectors).
+struct RigidUFaces {
+  std::vector<std::int32_t> index;
+  std::vector<double> alpha, zero;
+  CouplingIn in;
+  template <class Alpha>
+  RigidUFaces(int nu, int rows, Alpha a_of) {
+    for (int j = 0; j < rows; ++j)
+      for (int i = 0; i < nu; ++i)
+        if (const double a = a_of(i, j); a > 0)
+          index.push_back(i + nu * j), alpha.push_back(a), zero.push_back(0);
+    in.solid_u_index = index;
+    in.solid_u_alpha = alpha;
+    in.solid_u_velocity = zero;
+    in.solid_u_elastic = zero;
+  }
+  RigidUFaces(const RigidUFaces&) = delete;  // the spans point into this object
+  RigidUFaces& operator=(const RigidUFaces&) = delete;
+};
+
 // A block over rows 0..2 of the box, cut in row 3 (alpha 0.6) and in every other face of row 4
 // (alpha 0.2), at rest, in the body-force-driven periodic channel; its steady u along a column
 // after t = 150 at time step dt. Row 3's faces at odd i read row 4's cut faces, which are forced
@@ -676,22 +697,12 @@ std::vector<double> steady_sharp_block(double dt) {
   c.body = {2.0, 0.0};
   c.sharp_interface = true;
   Solver s(c, dt);
-  const int nu = s.grid().nu();
-  std::vector<std::int32_t> iu;
-  std::vector<double> au, zero;
-  for (int j = 0; j < 5; ++j)
-    for (int i = 0; i < nu; ++i) {
-      const double a = j < 3 ? 1.0 : j == 3 ? 0.6 : (i % 2 ? 0.2 : 0.0);
-      if (a > 0) iu.push_back(i + nu * j), au.push_back(a), zero.push_back(0);
-    }
-  CouplingIn in;
-  in.solid_u_index = iu;
-  in.solid_u_alpha = au;
-  in.solid_u_velocity = zero;
-  in.solid_u_elastic = zero;
+  const RigidUFaces block(s.grid().nu(), 5, [](int i, int j) {
+    return j < 3 ? 1.0 : j == 3 ? 0.6 : (i % 2 ? 0.2 : 0.0);
+  });
   CouplingOut out;
   const int steps = static_cast<int>(std::lround(150.0 / dt));
-  for (int n = 0; n < steps; ++n) s.step(dt, in, out);
+  for (int n = 0; n < steps; ++n) s.step(dt, block.in, out);
   std::vector<double> u;
   for (int j = 0; j < s.grid().ny(); ++j) u.push_back(s.u()(3, j)), u.push_back(s.u()(4, j));
   return u;
@@ -723,22 +734,14 @@ TEST_CASE("interface = sharp: a convex corner keeps Eq. 21, a side its line", "[
     return std::max(0.0, std::min(hi, b) - std::max(lo, a));
   };
   const double x0 = 4.25 * h, x1 = 8.75 * h, y0 = 2.75 * h, y1 = 5.75 * h;
-  std::vector<std::int32_t> iu;
-  std::vector<double> au, zero;
-  for (int j = 0; j < s.grid().ny(); ++j)
-    for (int i = 0; i < nu; ++i) {
-      const double a = overlap((i - 0.5) * h, (i + 0.5) * h, x0, x1) / h *
-                       overlap(j * h, (j + 1) * h, y0, y1) / h;
-      if (a > 0) iu.push_back(i + nu * j), au.push_back(a), zero.push_back(0);
-    }
-  CouplingIn in;
-  in.solid_u_index = iu;
-  in.solid_u_alpha = au;
-  in.solid_u_velocity = zero;
-  in.solid_u_elastic = zero;
+  const RigidUFaces block(nu, s.grid().ny(), [&](int i, int j) {
+    return overlap((i - 0.5) * h, (i + 0.5) * h, x0, x1) / h *
+           overlap(j * h, (j + 1) * h, y0, y1) / h;
+  });
   CouplingOut out;
-  s.step(dt, in, out);
+  s.step(dt, block.in, out);
   auto target = [&](int i, int j) {
+    const auto& iu = block.index;
     const auto q = std::find(iu.begin(), iu.end(), i + nu * j) - iu.begin();
     REQUIRE(std::size_t(q) < iu.size());
     return U + dt * out.solid_u_force[q] / c.density;
