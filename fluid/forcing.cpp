@@ -130,13 +130,13 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
 // (1 - alpha) u~ + alpha u_s; so does a face without a gradient (a sliver inside one box).
 // So does a face whose box holds a convex corner of two walls along the grid directions (a
 // rectangle's end: alpha = f_x f_y with both fractions partial, recognised from its neighbours
-// into the body, at_corner below). Its line would have to choose one wall: the larger gradient
-// ran along x at one corner of the Turek-Hron bar's trailing edge and along y at its mirror
-// image, and placed that wall at alpha instead of its own fraction; the asymmetry moved the
-// circulation, so the lift with the cells moved by a quarter of a cell was +11.5 % (CFD1) and
-// +18.1 % (CFD2) with such lines, +1.2 % and +3.4 % with the blend there
-// (runs/turek-hron-cfd/README.md, "The sharp interface"). A corner between walls not along the
-// grid directions is not recognised and keeps its line.
+// into the body, at_corner below). One line must take one of the two walls, and mirror-image
+// corners that meet the cells differently take different ones (the larger gradient along x at
+// one, along y at the other): two different corners where the body has two alike. At the
+// Turek-Hron bar's trailing edge such lines set the lift's dependence on the cells' alignment
+// (runs/turek-hron-cfd/README.md, "The sharp interface"). Not recognised, so keeping a line: a
+// corner between walls not along the grid directions, and one whose neighbour boxes one face
+// further in are not covered across (a body about two boxes thick or long).
 void Solver::sharp_targets(int comp, const CouplingIn& in, std::vector<double>& target) {
   const auto index = comp == 0 ? in.solid_u_index : in.solid_v_index;
   const auto alpha = comp == 0 ? in.solid_u_alpha : in.solid_v_alpha;
@@ -181,7 +181,7 @@ void Solver::sharp_targets(int comp, const CouplingIn& in, std::vector<double>& 
   };
   // Whether the face's box holds a convex corner of two walls along the grid directions: the
   // box is cut along x by the fraction f_x and along y by f_y, so alpha = f_x f_y, and its
-  // neighbour one face into the body along x (cut along y only: f_y) and along y (f_x) are
+  // neighbours one face into the body along x (cut along y only: f_y) and along y (f_x) are
   // partly covered with alpha_x alpha_y = alpha. g: d alpha / dx_d, both non-zero (the body lies
   // where alpha rises).
   auto at_corner = [&](int i, int j, double a, const double* g) {
