@@ -665,25 +665,25 @@ TEST_CASE("interface = sharp: a wall anywhere in its cell, a linear profile held
       }
 }
 
-// A fixed rigid body's u faces: those of rows 0 .. rows - 1 with a(i, j) > 0, at rest, no
-// elastic part (`in` spans the vectors).
-struct RigidUFaces {
+// A fixed rigid body's faces of family comp (0 = u, 1 = v; ni of them in a row): those of rows
+// 0 .. rows - 1 with a(i, j) > 0, at rest, no elastic part (`in` spans the vectors).
+struct RigidFaces {
   std::vector<std::int32_t> index;
   std::vector<double> alpha, zero;
   CouplingIn in;
   template <class Alpha>
-  RigidUFaces(int nu, int rows, Alpha a_of) {
+  RigidFaces(int comp, int ni, int rows, Alpha a_of) {
     for (int j = 0; j < rows; ++j)
-      for (int i = 0; i < nu; ++i)
+      for (int i = 0; i < ni; ++i)
         if (const double a = a_of(i, j); a > 0)
-          index.push_back(i + nu * j), alpha.push_back(a), zero.push_back(0);
-    in.solid_u_index = index;
-    in.solid_u_alpha = alpha;
-    in.solid_u_velocity = zero;
-    in.solid_u_elastic = zero;
+          index.push_back(i + ni * j), alpha.push_back(a), zero.push_back(0);
+    (comp == 0 ? in.solid_u_index : in.solid_v_index) = index;
+    (comp == 0 ? in.solid_u_alpha : in.solid_v_alpha) = alpha;
+    (comp == 0 ? in.solid_u_velocity : in.solid_v_velocity) = zero;
+    (comp == 0 ? in.solid_u_elastic : in.solid_v_elastic) = zero;
   }
-  RigidUFaces(const RigidUFaces&) = delete;  // the spans point into this object
-  RigidUFaces& operator=(const RigidUFaces&) = delete;
+  RigidFaces(const RigidFaces&) = delete;  // the spans point into this object
+  RigidFaces& operator=(const RigidFaces&) = delete;
 };
 
 // A block over rows 0..2 of the box, cut in row 3 (alpha 0.6) and in every other face of row 4
@@ -697,7 +697,7 @@ std::vector<double> steady_sharp_block(double dt) {
   c.body = {2.0, 0.0};
   c.sharp_interface = true;
   Solver s(c, dt);
-  const RigidUFaces block(s.grid().nu(), 5, [](int i, int j) {
+  const RigidFaces block(0, s.grid().nu(), 5, [](int i, int j) {
     return j < 3 ? 1.0 : j == 3 ? 0.6 : (i % 2 ? 0.2 : 0.0);
   });
   CouplingOut out;
@@ -716,48 +716,61 @@ TEST_CASE("interface = sharp: a forced neighbour read at its target, no slip of 
   CHECK(gap(coarse, fine) < 1e-10);
 }
 
-// A block at rest in a uniform stream U (periodic in x; rows 1..6 untouched by the walls, so
-// u~ = U there exactly), its edges at 3/4 and 1/4 of their cells: x in [4.25 h, 8.75 h], y in
-// [2.75 h, 5.75 h]. Each u face's target is read back from its force, target = u~ + dt f / rho.
-// The four faces whose boxes hold a corner keep Eq. 21 (target (1 - alpha) U); the faces cut by
-// one wall take the line through their neighbour (target r U, r = dist / span).
+// A block at rest in a uniform stream U along the family's direction (periodic both ways, so
+// u~ = U on every face exactly), its edges at 3/4 and 1/4 of their cells: along the stream
+// [4.25 h, 8.75 h], across it [2.75 h, 5.75 h]. Each face's target is read back from its force,
+// target = u~ + dt f / rho. The four faces whose boxes hold a corner keep Eq. 21 (target
+// (1 - alpha) U); the faces cut by one wall take the line through their neighbour (target r U,
+// r = dist / span). A face's box spans the cell centres along its own direction and the cell
+// across it, for either family.
 TEST_CASE("interface = sharp: a convex corner keeps Eq. 21, a side its line", "[fluid][coupling]") {
-  Config c = box(BcType::periodic);
-  c.sharp_interface = true;
-  const double dt = 1e-3, U = 0.4;
-  Solver s(c, dt);
-  const int nu = s.grid().nu();
-  const double h = 1.0 / 16;
-  for (int j = 0; j < s.grid().ny(); ++j)
-    for (int i = 0; i < nu; ++i) s.u()(i, j) = U;
-  auto overlap = [](double lo, double hi, double a, double b) {
-    return std::max(0.0, std::min(hi, b) - std::max(lo, a));
-  };
-  const double x0 = 4.25 * h, x1 = 8.75 * h, y0 = 2.75 * h, y1 = 5.75 * h;
-  const RigidUFaces block(nu, s.grid().ny(), [&](int i, int j) {
-    return overlap((i - 0.5) * h, (i + 0.5) * h, x0, x1) / h *
-           overlap(j * h, (j + 1) * h, y0, y1) / h;
-  });
-  CouplingOut out;
-  s.step(dt, block.in, out);
-  auto target = [&](int i, int j) {
-    const auto& iu = block.index;
-    const auto q = std::find(iu.begin(), iu.end(), i + nu * j) - iu.begin();
-    REQUIRE(std::size_t(q) < iu.size());
-    return U + dt * out.solid_u_force[q] / c.density;
-  };
-  // The corners: alpha = f_x f_y.
-  CHECK(target(9, 5) == Approx((1 - 0.25 * 0.75) * U).epsilon(1e-12));
-  CHECK(target(9, 2) == Approx((1 - 0.25 * 0.25) * U).epsilon(1e-12));
-  CHECK(target(4, 5) == Approx((1 - 0.25 * 0.75) * U).epsilon(1e-12));
-  CHECK(target(4, 2) == Approx((1 - 0.25 * 0.25) * U).epsilon(1e-12));
-  // The tip (x = 9 h, wall 0.25 h behind, neighbour at 10 h), the left end (x = 4 h, wall
-  // 0.25 h ahead), the top (y = 5.5 h inside, wall 0.25 h above, neighbour at 6.5 h) and the
-  // bottom (y = 2.5 h, wall 0.25 h above, neighbour at 1.5 h).
-  CHECK(target(9, 4) == Approx(0.2 * U).epsilon(1e-12));
-  CHECK(target(4, 4) == Approx(0.2 * U).epsilon(1e-12));
-  CHECK(target(6, 5) == Approx(-U / 3).epsilon(1e-12));
-  CHECK(target(6, 2) == Approx(0.2 * U).epsilon(1e-12));
+  for (int comp : {0, 1}) {
+    CAPTURE(comp);
+    Config c = box(BcType::periodic);
+    c.y = {16, 1.0, 0.0};
+    c.bc[bottom].type = c.bc[top].type = BcType::periodic;
+    c.sharp_interface = true;
+    const double dt = 1e-3, U = 0.4, h = 1.0 / 16;
+    Solver s(c, dt);
+    const int n = 16;  // faces per row and rows, either family
+    Field& w = comp == 0 ? s.u() : s.v();
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) w(i, j) = U;
+    auto overlap = [](double lo, double hi, double a, double b) {
+      return std::max(0.0, std::min(hi, b) - std::max(lo, a));
+    };
+    // Face (k, m): k along the stream, m across it.
+    auto alpha = [&](int k, int m) {
+      return overlap((k - 0.5) * h, (k + 0.5) * h, 4.25 * h, 8.75 * h) / h *
+             overlap(m * h, (m + 1) * h, 2.75 * h, 5.75 * h) / h;
+    };
+    const RigidFaces block(comp, n, n, [&](int i, int j) {
+      return comp == 0 ? alpha(i, j) : alpha(j, i);
+    });
+    CouplingOut out;
+    s.step(dt, block.in, out);
+    const std::vector<double>& force = comp == 0 ? out.solid_u_force : out.solid_v_force;
+    auto target = [&](int k, int m) {
+      const std::int32_t idx = comp == 0 ? k + n * m : m + n * k;
+      const auto& ix = block.index;
+      const auto q = std::find(ix.begin(), ix.end(), idx) - ix.begin();
+      REQUIRE(std::size_t(q) < ix.size());
+      return U + dt * force[q] / c.density;
+    };
+    // The corners: alpha = f_along f_across.
+    CHECK(target(9, 5) == Approx((1 - 0.25 * 0.75) * U).epsilon(1e-12));
+    CHECK(target(9, 2) == Approx((1 - 0.25 * 0.25) * U).epsilon(1e-12));
+    CHECK(target(4, 5) == Approx((1 - 0.25 * 0.75) * U).epsilon(1e-12));
+    CHECK(target(4, 2) == Approx((1 - 0.25 * 0.25) * U).epsilon(1e-12));
+    // The downstream end (k = 9, wall 0.25 h behind, neighbour at 10 h), the upstream end
+    // (k = 4, wall 0.25 h ahead), one side (centre 5.5 h inside, wall 0.25 h further out,
+    // neighbour at 6.5 h) and the other (centre 2.5 h, wall 0.25 h further in, neighbour at
+    // 1.5 h).
+    CHECK(target(9, 4) == Approx(0.2 * U).epsilon(1e-12));
+    CHECK(target(4, 4) == Approx(0.2 * U).epsilon(1e-12));
+    CHECK(target(6, 5) == Approx(-U / 3).epsilon(1e-12));
+    CHECK(target(6, 2) == Approx(0.2 * U).epsilon(1e-12));
+  }
 }
 
 // A redo with the step's own input gives the step's fields and force bit for bit: the lines
