@@ -106,14 +106,14 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
 // angles to d (the box's area fraction is then the fraction of its centre line, on whichever
 // side; on even cells the box's own centre line along d is the face's, where the face's
 // velocity lives; on graded ones a slanted wall is placed off by a fraction of the cells'
-// difference). With x_f the
-// face and x_n its neighbour one face further into the fluid, dist = s (x_f - x_w) (in about
-// [-h/2, h/2]: the box meets the wall),
+// difference). With x_f the face and x_n its neighbour one face further into the fluid,
+// dist = s (x_f - x_w) (in about [-h/2, h/2]: the box meets the wall),
 //   u = u_s + (u~_n - u_s) dist / (s (x_n - x_w)),
 // the line from the wall's velocity at x_w through the fluid's at x_n: an interpolation when the
 // face's centre is in the fluid (Fadlun et al. 2000, J. Comput. Phys. 161, 35, along one grid
 // direction), an extrapolation into the body when it is inside (weight on u~_n down to -1 on
-// even cells, below it where cells shrink towards the fluid), as a ghost cell. Either way the faces hold a linear profile whatever the wall's place in the cell:
+// even cells, below it where cells shrink towards the fluid), as a ghost cell. Either way the
+// faces hold a linear profile whatever the wall's place in the cell:
 // the faces a box-based footprint lists are those within half a cell of the wall, so the first
 // fluid face beyond a face whose centre is inside is not listed, and holding that face at u_s
 // would put the wall at its centre. u_s, the body's mean velocity in the box, stands for the

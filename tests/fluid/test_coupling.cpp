@@ -665,41 +665,44 @@ TEST_CASE("interface = sharp: a wall anywhere in its cell, a linear profile held
       }
 }
 
-// A fixed rigid body's faces of family comp (0 = u, 1 = v; ni of them in a row): those of rows
-// 0 .. rows - 1 with a(i, j) > 0, at rest, no elastic part (`in` spans the vectors).
+// A rigid body's faces of family comp (0 = u, 1 = v; ni of them in a row): those of rows
+// 0 .. rows - 1 with a(i, j) > 0, all at the velocity w along the family, no elastic part
+// (`in` spans the vectors).
 struct RigidFaces {
   std::vector<std::int32_t> index;
-  std::vector<double> alpha, zero;
+  std::vector<double> alpha, velocity, zero;
   CouplingIn in;
   template <class Alpha>
-  RigidFaces(int comp, int ni, int rows, Alpha a_of) {
+  RigidFaces(int comp, int ni, int rows, Alpha a_of, double w = 0) {
     for (int j = 0; j < rows; ++j)
       for (int i = 0; i < ni; ++i)
         if (const double a = a_of(i, j); a > 0)
-          index.push_back(i + ni * j), alpha.push_back(a), zero.push_back(0);
+          index.push_back(i + ni * j), alpha.push_back(a), velocity.push_back(w), zero.push_back(0);
     (comp == 0 ? in.solid_u_index : in.solid_v_index) = index;
     (comp == 0 ? in.solid_u_alpha : in.solid_v_alpha) = alpha;
-    (comp == 0 ? in.solid_u_velocity : in.solid_v_velocity) = zero;
+    (comp == 0 ? in.solid_u_velocity : in.solid_v_velocity) = velocity;
     (comp == 0 ? in.solid_u_elastic : in.solid_v_elastic) = zero;
   }
   RigidFaces(const RigidFaces&) = delete;  // the spans point into this object
   RigidFaces& operator=(const RigidFaces&) = delete;
 };
 
-// A block over rows 0..2 of the box, cut in row 3 (alpha 0.6) and in every other face of row 4
-// (alpha 0.2), at rest, in the body-force-driven periodic channel; its steady u along a column
+// The u faces' alpha of a block over rows 0..2 of the box, cut in row 3 (alpha 0.6) and in every
+// other face of row 4 (alpha 0.2).
+double cut_block(int i, int j) { return j < 3 ? 1.0 : j == 3 ? 0.6 : (i % 2 ? 0.2 : 0.0); }
+
+// That block at rest in the body-force-driven periodic channel; its steady u along a column
 // after t = 150 at time step dt. Row 3's faces at odd i read row 4's cut faces, which are forced
 // themselves: read at their targets, every target depends on velocities alone, so the steady
 // state does not depend on dt (read at their predictors, the slip dt R of a forced face would
 // enter).
+
 std::vector<double> steady_sharp_block(double dt) {
   Config c = box(BcType::periodic);
   c.body = {2.0, 0.0};
   c.sharp_interface = true;
   Solver s(c, dt);
-  const RigidFaces block(0, s.grid().nu(), 5, [](int i, int j) {
-    return j < 3 ? 1.0 : j == 3 ? 0.6 : (i % 2 ? 0.2 : 0.0);
-  });
+  const RigidFaces block(0, s.grid().nu(), 5, cut_block);
   CouplingOut out;
   const int steps = static_cast<int>(std::lround(150.0 / dt));
   for (int n = 0; n < steps; ++n) s.step(dt, block.in, out);
@@ -780,21 +783,10 @@ TEST_CASE("interface = sharp: a redo with the same input repeats the step", "[fl
   c.sharp_interface = true;
   const double dt = 1e-3;
   Solver s(c, dt);
-  const int nu = s.grid().nu();
-  // A block over rows 0..2 and cut in row 3 (alpha 0.6 and 0.2 along it), moving at 0.2: covered
-  // faces that extrapolate, cut ones that interpolate, a forced neighbour read at its target.
-  std::vector<std::int32_t> iu;
-  std::vector<double> au, uu, zero;
-  for (int j = 0; j < 5; ++j)
-    for (int i = 0; i < nu; ++i) {
-      const double a = j < 3 ? 1.0 : j == 3 ? 0.6 : (i % 2 ? 0.2 : 0.0);
-      if (a > 0) iu.push_back(i + nu * j), au.push_back(a), uu.push_back(0.2), zero.push_back(0);
-    }
-  CouplingIn in;
-  in.solid_u_index = iu;
-  in.solid_u_alpha = au;
-  in.solid_u_velocity = uu;
-  in.solid_u_elastic = zero;
+  // The cut block above, moving at 0.2: covered faces that extrapolate, cut ones that
+  // interpolate, a forced neighbour read at its target.
+  const RigidFaces block(0, s.grid().nu(), 5, cut_block, 0.2);
+  const CouplingIn& in = block.in;
   CouplingOut out, out2;
   for (int n = 0; n < 3; ++n) s.step(dt, in, out);
   const Field u1 = s.u(), p1 = s.p();
