@@ -7,6 +7,7 @@ import glob
 import html
 import json
 import os
+import shutil
 import subprocess
 
 import matplotlib
@@ -126,6 +127,17 @@ def case_plot(name, s, peer_rows, dest):
     fig.savefig(os.path.join(dest, png), dpi=100)
     plt.close(fig)
     return png
+
+
+def case_study(folder, name, dest):
+    """A case's own error-against-cost study, folder/cost.png (turek-hron-cfd's `validate.py
+    --cost`, turek-hron-fsi's cost.py), copied into dest: (file name, when written), or None."""
+    src = os.path.join(folder, "cost.png")
+    if not os.path.isfile(src):
+        return None
+    png = f"{name}_study_cost.png"
+    shutil.copyfile(src, os.path.join(dest, png))
+    return png, datetime.datetime.fromtimestamp(os.path.getmtime(src)).strftime("%Y-%m-%d %H:%M")
 
 
 def bench_plots(bench, dest):
@@ -276,6 +288,12 @@ def write(out, dest, runs_dir):
             h.append("<p class=note>One marker per run, labelled with its grid; this project's CPU "
                      "time is that of the whole run as the case script sets it up (to its t_end), "
                      "a peer's as its row in the table below says.</p>")
+        study = case_study(os.path.dirname(s["path"]), c, dest)
+        if study:
+            h.append(f"<p>The case's own study of error against CPU time (its "
+                     f"<code>cost.png</code>, written {study[1]}, by the mode its README names: "
+                     f"the runs of every variant it has kept, not only this summary's):</p>"
+                     f"<p><img src='{study[0]}' alt='{c}: its error-against-cost study'></p>")
         if not s.get("per_run"):
             h.append("<p class=note>This case's summary has no per-run entries (grid, Δt, error, "
                      "wall, CPU): no error-against-cost plot of its own runs. A case records them "
@@ -308,6 +326,15 @@ def write(out, dest, runs_dir):
         if c in by_case:
             h.append(f"<p class=note>Peers' points on this plot: {len(by_case[c])} rows of "
                      "runs/lib/peers.csv (below).</p>")
+
+    # Cases with a study of their own (cost.png) but no summary.
+    for c in sorted(set(known) - set(found)):
+        study = case_study(os.path.join(out, c), c, dest)
+        if study:
+            h.append(f"<h2 id='{c}-study'>{c} (no summary; its own study)</h2>"
+                     f"<p>The case's study of error against CPU time (<code>out/{c}/cost.png"
+                     f"</code>, written {study[1]}):</p>"
+                     f"<p><img src='{study[0]}' alt='{c}: its error-against-cost study'></p>")
 
     # Cases with peers' numbers but no summary of their own.
     for c in sorted(set(by_case) - set(found)):

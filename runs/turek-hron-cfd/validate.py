@@ -459,14 +459,18 @@ def write_rows(path, rows):
 def cost():
     """Error against CPU time (and cells) of what the other modes wrote: the uniform grids
     (summary.json's levels), the y band (bands.json), the x and y bands (bands_xy.json,
-    bands_xy_dt.json, and with a forcing_time bands_xy-tau*.json): cost.md and cost.png. Runs
-    nothing."""
+    bands_xy_dt.json, and with a forcing_time bands_xy-tau*.json), and the same of the sharp
+    interface under interface-sharp/ (its uniform grids, and every bands_xy*.json there, each
+    run labelled with its alignment s): cost.md and cost.png. Runs nothing."""
     groups = []
-    summary = os.path.join(OUT, "summary.json")
-    if os.path.exists(summary):
-        with open(summary) as f:
-            levels = json.load(f).get("levels", [])
-        groups.append(("uniform", "o-", levels))
+
+    def uniform(folder, label, style):
+        summary = os.path.join(folder, "summary.json")
+        if os.path.exists(summary):
+            with open(summary) as f:
+                groups.append((label, style, json.load(f).get("levels", [])))
+
+    uniform(OUT, "uniform", "o-")
     taus = sorted(glob.glob(os.path.join(OUT, "bands_xy-tau*.json")))
     for name, label, style in [("bands.json", "y band", "s"), ("bands_xy.json", "x and y bands", "^-"),
                                ("bands_xy_dt.json", "x and y bands, smaller dt", "v")] + [
@@ -476,18 +480,34 @@ def cost():
         if os.path.exists(path):
             with open(path) as f:
                 groups.append((label, style, json.load(f)))
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    sharp = os.path.join(OUT, "interface-sharp")
+    uniform(sharp, "uniform, sharp", "o--")
+    rows, seen = [], set()
+    for path in sorted(glob.glob(os.path.join(sharp, "bands_xy*.json"))):
+        with open(path) as f:
+            for x in json.load(f):
+                key = (x["case"], tuple(x["cells"]), x["dt"], x.get("shift", 0.0))
+                if key not in seen:
+                    seen.add(key)
+                    rows.append(x)
+    for shift in sorted({x.get("shift", 0.0) for x in rows}):
+        groups.append((f"x and y bands, sharp, s = {shift:g}", "*",
+                       sorted((x for x in rows if x.get("shift", 0.0) == shift),
+                              key=lambda x: x["cpu_s"] or 0)))
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.5))
     with open(os.path.join(OUT, "cost.md"), "w") as md:
         md.write("| grid | case | cells | dt | steps | drag error | lift error | wall s | CPU s |\n"
                  "|---|---|---|---|---|---|---|---|---|\n")
-        for label, style, rows in groups:
+        colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+        for g, (label, style, rows) in enumerate(groups):
             for case, ax in zip(["cfd1", "cfd2"], axes):
                 r = [x for x in rows if x["case"] == case and x.get("cpu_s")]
                 if not r:
                     continue
                 for q, fill in [("drag", None), ("lift", "none")]:
                     ax.loglog([x["cpu_s"] for x in r], [max(abs(x[f"{q}_error"]), 1e-5) for x in r],
-                              style, mfc=fill, label=f"{label}: {q}")
+                              style, mfc=fill, color=colours[g % len(colours)],
+                              label=label if q == "drag" else None)
             for x in rows:
                 cells = x["cells"][0] * x["cells"][1]
                 cpu = "-" if not x.get("cpu_s") else f"{x['cpu_s']:.0f}"
@@ -498,9 +518,14 @@ def cost():
         ax.axhline(0.01, color="k", ls=":", lw=0.8)
         ax.set_xlabel("CPU time of the job [s]")
         ax.set_ylabel("|error| against Turek & Hron")
-        ax.set_title(case.upper(), fontsize=9)
-        ax.legend(fontsize=7)
-    fig.tight_layout()
+        ax.set_title(f"{case.upper()} (filled: drag, open: lift; dotted: 1 %)", fontsize=9)
+    handles, labels = axes[0].get_legend_handles_labels()
+    for h, lab in zip(*axes[1].get_legend_handles_labels()):
+        if lab not in labels:
+            handles.append(h)
+            labels.append(lab)
+    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=8)
+    fig.tight_layout(rect=(0, 0.02 + 0.035 * ((len(labels) + 2) // 3), 1, 1))
     fig.savefig(os.path.join(OUT, "cost.png"), dpi=120)
     plt.close(fig)
     print(open(os.path.join(OUT, "cost.md")).read())

@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """./fsi report on synthetic outputs: a case with per-run entries, one without (and without
 timings), a benchmark JSON; the page must name them as such, list the missing benchmarks and
-not-run cases, state the machine and commit, and its plots must be real pictures.
+not-run cases, state the machine and commit, and its plots must be real pictures. A case's own
+study (OUT/<case>/cost.png) is shown in its section, and for a case without a summary in a
+section of its own.
 
 usage: check_report.py WORK_DIR
 """
@@ -13,7 +15,13 @@ import shutil
 import subprocess
 import sys
 
-from check_picture import ROOT, png_problems
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from check_picture import ROOT, png_problems  # noqa: E402
 
 CASE = {"case": "synthetic-grid", "short": True, "pass": True, "wall_s": 3.0, "cpu_s": 2.5,
         "metrics": {"space_order": {"value": 1.98, "reference": 2.0, "error": 0.0,
@@ -43,6 +51,11 @@ def main():
         os.makedirs(os.path.join(out, name))
         with open(os.path.join(out, name, "summary.json"), "w") as f:
             json.dump(s, f)
+    # The cases' own studies: one beside a summary, one without (turek-hron-fsi has none here).
+    os.makedirs(os.path.join(out, "turek-hron-fsi"))
+    for name in ("synthetic-grid", "turek-hron-fsi"):
+        plt.imsave(os.path.join(out, name, "cost.png"),
+                   np.random.default_rng(len(name)).random((320, 480, 3)))
     os.makedirs(os.path.join(out, "bench"))
     with open(os.path.join(out, "bench", "fluid.json"), "w") as f:
         json.dump(FLUID, f)
@@ -58,11 +71,13 @@ def main():
               r"<td>3 runs</td>", r"synthetic-bare.*no per-run entries", r"<td>no timings</td>",
               r"Missing \(no out/bench.*solid.*coupled", r"not run: no out/taylor-green/summary\.json",
               r"an exact solution \(synthetic\)", r"space_order 1\.98", r"OpenFOAM", r"CalculiX",
-              r"class=fail>FAIL"]
+              r"class=fail>FAIL", r"not run: no out/turek-hron-fsi/summary\.json",
+              r"turek-hron-fsi \(no summary; its own study\)"]
     for rx in expect:
         if not re.search(rx, text, re.S):
             bad.append(f"the page does not match /{rx}/")
-    for png in ["synthetic-grid_error_cpu.png", "bench_fluid.png"]:
+    for png in ["synthetic-grid_error_cpu.png", "bench_fluid.png", "synthetic-grid_study_cost.png",
+                "turek-hron-fsi_study_cost.png"]:
         if f"src='{png}'" not in text:
             bad.append(f"the page does not show {png}")
         bad += png_problems(os.path.join(out, "report", png))
