@@ -230,6 +230,9 @@ void Solver::project(double dt, double t_new) {
     solve(2);
   }
   const PhaseTimer t(m_time.projection, m_time.cpu);
+  m_sharp_kept.resize(m_sharp_sealed.size());
+  for (std::size_t q = 0; q < m_sharp_sealed.size(); ++q)
+    m_sharp_kept[q] = m_p(m_sharp_sealed[q] % nx, m_sharp_sealed[q] / nx);
   for (int j = lo; j < hi; ++j) {
     double* phi = m_phi.row(j);
     double* p = m_p.row(j);
@@ -238,6 +241,10 @@ void Solver::project(double dt, double t_new) {
       p[i] += phi[i];
     }
   }
+  // interface = "sharp": the cells walled in by faces set whole keep p^n (sealed_cells()).
+  for (std::size_t q = 0; q < m_sharp_sealed.size(); ++q)
+    m_p(m_sharp_sealed[q] % nx, m_sharp_sealed[q] / nx) = m_sharp_kept[q];
+  m_sharp_sealed.clear();
   m_bnd.fill_scalar(m_phi, m_phi_b);
   m_bnd.fill_scalar(m_p, m_face_p);
   const double c = dt / m_cfg.density;
