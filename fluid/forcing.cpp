@@ -61,10 +61,11 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
               in.solid_u_index.size(), in.solid_v_index.size());
   const bool sharp = m_cfg.sharp_interface;
   if (sharp) {
+    for (const auto& [comp, f] : m_sharp_whole_list) m_sharp_whole[comp][f] = 0;
     m_sharp_whole_list.clear();
     sharp_targets(0, in, m_sharp_target[0]);
     sharp_targets(1, in, m_sharp_target[1]);
-    sealed_cells(in.solid_u_index.size() + in.solid_v_index.size());
+    sealed_cells();
   }
   // The force on one face, whose velocity is w (alpha a, body velocity ws, pull of the
   // increment's forcing; sharp: ws is the face's target, reached whole).
@@ -248,12 +249,16 @@ void Solver::sharp_targets(int comp, const CouplingIn& in, std::vector<double>& 
     const std::int32_t qn = slot[l.i + std::size_t(ni) * l.j];
     if (qn >= 0) target[q] = us[q] + (first[qn] - us[q]) * l.r;
   }
-  // The faces set whole on a rigid body: held at u_s (covered) or on a line.
+  // Every listed face for sealed_cells(): 1 when set whole on a rigid body (held at u_s when
+  // covered, or on a line), 2 otherwise.
   std::vector<std::uint8_t>& whole = m_sharp_whole[comp];
   if (whole.size() != std::size_t(ni) * nj) whole.assign(std::size_t(ni) * nj, 0);
-  for (std::size_t q = 0; q < index.size(); ++q)
-    if (!elastic.empty() && !(elastic[q] > kTouched) && (alpha[q] >= kCovered || lines[q].i >= 0))
-      whole[index[q]] = 1, m_sharp_whole_list.push_back({comp, index[q]});
+  for (std::size_t q = 0; q < index.size(); ++q) {
+    const bool set = !elastic.empty() && !(elastic[q] > kTouched) &&
+                     (alpha[q] >= kCovered || lines[q].i >= 0);
+    whole[index[q]] = set ? 1 : 2;
+    m_sharp_whole_list.push_back({comp, index[q]});
+  }
   for (std::size_t q = 0; q < index.size(); ++q) amap[index[q]] = 0.0, slot[index[q]] = -1;
 }
 
@@ -264,30 +269,34 @@ void Solver::sharp_targets(int comp, const CouplingIn& in, std::vector<double>& 
 // (inside the Turek-Hron obstacle to 1e7 Pa by t = 10 on 600 x 123, against about 500 Pa
 // outside), and with it the velocity of the few faces inside a group that the forcing blends
 // (Eq. 21 with alpha near 1, where no line was drawn), by (1 - alpha) dt grad p / rho a step.
-// project() keeps p^n in these cells. Their pressure acts on the fluid only through those
-// blended faces; a wall face between a group and the fluid is set whole whatever its predictor,
-// and a rigid body's force and torque, sums over its forced faces, take each inner cell's
-// pressure once with each sign. A group is found by walking from the cells beside whole faces
-// across every other face; one that reaches a domain side or grows past the listed faces'
-// count is the fluid.
-void Solver::sealed_cells(std::size_t listed) {
+// project() keeps p^n in these cells. Their pressure reaches the fluid only through those
+// blended faces: a face between a group and the fluid is set whole whatever its predictor's
+// -grad p^n, and the sum of the whole faces' reactions f |V| over a body takes each inner
+// cell's pressure once with each sign (a blended face's reaction takes alpha of its gradient,
+// so a body's force moves by (1 - alpha) of the pressure differences across those faces, which
+// no longer grow). A group is found by walking from the cells beside whole faces across every
+// other face the coupling listed; one that meets a face it did not list (alpha = 0: fluid) or
+// a domain side is the fluid, so the walk stays within the listed faces.
+void Solver::sealed_cells() {
   const int nx = m_grid.nx(), ny = m_grid.ny();
   const int nu = m_grid.nu(), nv = m_grid.nv();
   const bool px = m_grid.x().periodic(), py = m_grid.y().periodic();
   const std::vector<std::uint8_t>&wu = m_sharp_whole[0], &wv = m_sharp_whole[1];
   m_sharp_sealed.clear();
-  if (wu.empty() || wv.empty()) return;
-  std::vector<std::int32_t>& mark = m_sharp_mark;
+  std::vector<std::uint8_t>& mark = m_sharp_mark;
   if (mark.size() != std::size_t(nx) * ny) mark.assign(std::size_t(nx) * ny, 0);
   std::vector<std::int32_t>& queue = m_sharp_queue;
-  std::vector<std::int32_t> touched;
+  std::vector<std::int32_t>& touched = m_sharp_touched;
+  touched.clear();
   // From cell (i, j), the neighbour across side k (0 west, 1 east, 2 south, 3 north): -1 when a
-  // whole face is between them, -2 when the side is a domain side.
+  // whole face is between them, -2 when the face is not listed or the side is a domain side.
   auto across = [&](int i, int j, int k) -> std::int32_t {
     const bool xdir = k < 2;
     const int f = xdir ? i + (k == 1) : j + (k == 3);  // the face's index along its direction
     const int fi = xdir ? (px ? f % nu : f) : i, fj = xdir ? j : (py ? f % nv : f);
-    if (xdir ? wu[fi + std::size_t(nu) * fj] : wv[fi + std::size_t(nx) * fj]) return -1;
+    const std::uint8_t w = xdir ? wu[fi + std::size_t(nu) * fj] : wv[fi + std::size_t(nx) * fj];
+    if (w == 1) return -1;
+    if (w == 0) return -2;
     int ci = i + (k == 1) - (k == 0), cj = j + (k == 3) - (k == 2);
     if (px) ci = (ci + nx) % nx;
     if (py) cj = (cj + ny) % ny;
@@ -296,30 +305,29 @@ void Solver::sealed_cells(std::size_t listed) {
   };
   auto seed = [&](std::int32_t c) {
     if (mark[c] != 0) return;
-    // Walk the group; mark 1 while open, then 2 (sealed) or 3 (the fluid).
+    // Walk the group: 1 while walking, then 2 (sealed) or 3 (the fluid).
     queue.assign(1, c);
     mark[c] = 1;
     touched.push_back(c);
-    bool open = false;
-    for (std::size_t h = 0; h < queue.size() && !open; ++h) {
+    bool is_open = false;
+    for (std::size_t h = 0; h < queue.size() && !is_open; ++h) {
       const int i = queue[h] % nx, j = queue[h] / nx;
-      for (int k = 0; k < 4 && !open; ++k) {
+      for (int k = 0; k < 4; ++k) {
         const std::int32_t n = across(i, j, k);
         if (n == -1) continue;
-        if (n == -2 || mark[n] == 3) { open = true; break; }
-        if (mark[n] == 0) {
-          mark[n] = 1, queue.push_back(n), touched.push_back(n);
-          if (queue.size() > listed) open = true;
+        if (n == -2 || mark[n] == 3) {
+          is_open = true;
+          break;
         }
+        if (mark[n] == 0) mark[n] = 1, queue.push_back(n), touched.push_back(n);
       }
     }
-    for (const std::int32_t q : queue) mark[q] = open ? 3 : 2;
-    if (open) return;
-    m_sharp_sealed.insert(m_sharp_sealed.end(), queue.begin(), queue.end());
+    for (const std::int32_t q : queue) mark[q] = is_open ? 3 : 2;
+    if (!is_open) m_sharp_sealed.insert(m_sharp_sealed.end(), queue.begin(), queue.end());
   };
-  // Seeds: the cells on either side of each whole face, in the input's order of families and
-  // faces (the groups do not depend on it).
+  // Seeds: the cells on either side of each whole face.
   for (const auto& [comp, f] : m_sharp_whole_list) {
+    if ((comp == 0 ? wu : wv)[f] != 1) continue;
     if (comp == 0) {
       const int i = f % nu, j = f / nu;
       if (i < nx) seed(i + nx * j);

@@ -175,7 +175,7 @@ class Solver {
   // interface = "sharp": the value each solid face of family comp (0 = u, 1 = v) is forced to
   // from the predictor, in the input's order (forcing.cpp).
   void sharp_targets(int comp, const CouplingIn& in, std::vector<double>& target);
-  void sealed_cells(std::size_t listed);
+  void sealed_cells();
   void remove_body_viscosity(double dt, const CouplingIn& in);  // body_viscosity.cpp
   // dt, and the time whose boundary pressures p^(n+1) takes (t^n + dt; t^n for project_initial).
   void project(double dt, double t_new);                                    // projection.cpp
@@ -257,12 +257,13 @@ class Solver {
     double r = 0;        // its weight, dist / span
   };
   std::array<std::vector<SharpLine>, 2> m_sharp_lines;
-  // Per family, the faces the sharp interface sets whole on rigid bodies (zero between
-  // steps); the step's cells walled in by such faces (m_sharp_sealed), whose p^n project()
-  // keeps (m_sharp_kept). Scratch: the cells' marks, a queue.
+  // Per family, the listed faces (1: set whole on a rigid body, 2: otherwise, 0 between
+  // steps) and their list; the step's cells walled in by whole faces (m_sharp_sealed), whose
+  // p^n project() keeps (m_sharp_kept). Scratch: the cells' marks, a queue, the marked cells.
   std::array<std::vector<std::uint8_t>, 2> m_sharp_whole;
   std::vector<std::pair<int, std::int32_t>> m_sharp_whole_list;  // (family, face) of each
-  std::vector<std::int32_t> m_sharp_sealed, m_sharp_mark, m_sharp_queue;
+  std::vector<std::uint8_t> m_sharp_mark;
+  std::vector<std::int32_t> m_sharp_sealed, m_sharp_queue, m_sharp_touched;
   std::vector<double> m_sharp_kept;
   // body_viscosity = "none": the elastic bodies' volume fraction per u, v face, zero
   // between steps; the step's α, centre fluxes (u, v) and corner fluxes on their boxes

@@ -778,8 +778,9 @@ TEST_CASE("interface = sharp: a convex corner keeps Eq. 21, a side its line", "[
 
 // The fluid walled in by a rigid body's forced faces: the ghost faces' values leave the forced
 // field a divergence in the cells beside them at every step, whose increment the incremental
-// projection would keep, so that p inside grew linearly. Those cells keep p^n, and p stays
-// where the flow puts it outside.
+// projection would keep, so that p inside grew linearly. Those cells keep p^n (here the
+// initial 0), and the fluid's cells go on: in a box periodic both ways no domain side tells
+// the fluid from a body, the faces the coupling did not list do.
 TEST_CASE("interface = sharp: the pressure walled in by a rigid body keeps p^n",
           "[fluid][coupling]") {
   Config c = box(BcType::periodic);
@@ -822,17 +823,8 @@ TEST_CASE("interface = sharp: the pressure walled in by a rigid body keeps p^n",
   run(200);
   const auto p2 = inside();
   CHECK(p2 == p1);
-  // The stream's pressure moves, so the test would see one that did not.
+  // The stream's pressure still moves: the fluid was not taken for a walled-in group.
   CHECK(s.p()(12, 8) != free1);
-  // The pressure inside is no larger than the flow's around the block (cells clear of its
-  // outline, rows 2..5 and columns 4..8).
-  double most_out = 0, most_in = 0;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i)
-      if (i < 4 || i > 8 || j < 2 || j > 5) most_out = std::max(most_out, std::abs(s.p()(i, j)));
-  for (const double x : p2) most_in = std::max(most_in, std::abs(x));
-  CAPTURE(most_in, most_out);
-  CHECK(most_in <= most_out);
 }
 
 // A redo with the step's own input gives the step's fields and force bit for bit: the lines
