@@ -47,6 +47,17 @@ def h5_datasets(path):
     return out
 
 
+def first_difference(a, b):
+    """Where two CSV texts first differ: the line number and both lines (or which one ends)."""
+    la, lb = a.decode(errors="replace").splitlines(), b.decode(errors="replace").splitlines()
+    for n, (x, y) in enumerate(zip(la, lb), start=1):
+        if x != y:
+            return f"line {n}: {x[:200]!r} against {y[:200]!r}"
+    if len(la) != len(lb):
+        return f"{len(la)} lines against {len(lb)}"
+    return "the same lines, other line ends"
+
+
 def compare_dirs(first, second, new=None):
     """The first difference between two output folders as a message, or None; and the count of
     files and datasets compared. With `new` (a list), datasets that only the second folder's .h5
@@ -57,8 +68,10 @@ def compare_dirs(first, second, new=None):
         if names(first, ext) != names(second, ext):
             return f"the folders hold other {ext} files: {names(first, ext)} against {names(second, ext)}", compared
     for name in names(first, "*.csv"):
-        if open(os.path.join(first, name), "rb").read() != open(os.path.join(second, name), "rb").read():
-            return f"{name} differs", compared
+        a = open(os.path.join(first, name), "rb").read()
+        b = open(os.path.join(second, name), "rb").read()
+        if a != b:
+            return f"{name} differs: {first_difference(a, b)}", compared
         compared += 1
     for name in names(first, "*.h5"):
         d1 = h5_datasets(os.path.join(first, name))
