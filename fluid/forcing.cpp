@@ -61,8 +61,6 @@ void Solver::immersed_forcing(double dt, const CouplingIn& in, CouplingOut& out)
               in.solid_u_index.size(), in.solid_v_index.size());
   const bool sharp = m_cfg.sharp_interface;
   if (sharp) {
-    for (const auto& [comp, f] : m_sharp_whole_list) m_sharp_whole[comp][f] = 0;
-    m_sharp_whole_list.clear();
     sharp_targets(0, in, m_sharp_target[0]);
     sharp_targets(1, in, m_sharp_target[1]);
     sealed_cells();
